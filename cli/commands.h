@@ -1,0 +1,9 @@
+// The subcommands of the ampi program. Each takes its own argv (argv[0] is the
+// subcommand's name), returns the exit code, and may throw: main prints the message.
+#pragma once
+
+namespace ampi::cli {
+
+int cmd_info(int argc, char** argv);
+
+}  // namespace ampi::cli

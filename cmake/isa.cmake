@@ -1,0 +1,42 @@
+# Per-instruction-set sources. Kernels for one ISA live in files named *_avx2.cpp,
+# *_avx512.cpp or *_neon.cpp; only those files get that ISA's compiler flags, so the
+# rest of the program stays portable and dispatch picks a variant at run time.
+
+if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
+  set(AMPI_ARCH_X86 ON)
+elseif(CMAKE_SYSTEM_PROCESSOR MATCHES "^(aarch64|arm64)$")
+  set(AMPI_ARCH_ARM64 ON)
+endif()
+
+# Drop the sources of instruction sets this target architecture cannot run.
+function(ampi_filter_isa_sources var)
+  set(kept)
+  foreach(src IN LISTS ${var})
+    if(src MATCHES "_(avx2|avx512)\\.cpp$" AND NOT AMPI_ARCH_X86)
+      continue()
+    endif()
+    if(src MATCHES "_neon\\.cpp$" AND NOT AMPI_ARCH_ARM64)
+      continue()
+    endif()
+    list(APPEND kept ${src})
+  endforeach()
+  set(${var} ${kept} PARENT_SCOPE)
+endfunction()
+
+function(ampi_set_isa_flags target)
+  get_target_property(srcs ${target} SOURCES)
+  foreach(src IN LISTS srcs)
+    if(src MATCHES "_avx2\\.cpp$")
+      set_source_files_properties(${src} PROPERTIES COMPILE_OPTIONS "-mavx2;-mfma;-mf16c")
+    elseif(src MATCHES "_avx512\\.cpp$")
+      set_source_files_properties(${src} PROPERTIES
+        # GCC 12 warns falsely inside its own masked-load intrinsics.
+        COMPILE_OPTIONS "-mavx512f;-mavx512bw;-mavx512vl;-mavx512dq;-mfma;-mf16c;-Wno-maybe-uninitialized")
+    endif()
+  endforeach()
+  if(AMPI_ARCH_X86)
+    target_compile_definitions(${target} PUBLIC AMPI_ARCH_X86=1)
+  elseif(AMPI_ARCH_ARM64)
+    target_compile_definitions(${target} PUBLIC AMPI_ARCH_ARM64=1)
+  endif()
+endfunction()

@@ -1,0 +1,64 @@
+// Vector activation functions for AVX2 (8 floats). Include only from *_avx2.cpp files.
+// exp uses the Cephes single-precision polynomial after range reduction to
+// [-ln2/2, ln2/2]; relative error about 2e-7, enough for every epilogue here.
+#pragma once
+#include <immintrin.h>
+
+#include "kernels/activation.h"
+
+namespace ampi::avx2 {
+
+inline __m256 exp(__m256 x) {
+  x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(-87.3f)), _mm256_set1_ps(88.3f));
+  const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504088896341f)),
+                                   _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  __m256 r = _mm256_fnmadd_ps(n, _mm256_set1_ps(0.693359375f), x);
+  r = _mm256_fnmadd_ps(n, _mm256_set1_ps(-2.12194440e-4f), r);
+  __m256 p = _mm256_set1_ps(1.9875691500e-4f);
+  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.3981999507e-3f));
+  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(8.3334519073e-3f));
+  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(4.1665795894e-2f));
+  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.6666665459e-1f));
+  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(5.0000001201e-1f));
+  p = _mm256_fmadd_ps(p, _mm256_mul_ps(r, r), _mm256_add_ps(r, _mm256_set1_ps(1.0f)));
+  const __m256i e = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
+  return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
+}
+
+inline __m256 sigmoid(__m256 x) {
+  const __m256 one = _mm256_set1_ps(1.0f);
+  return _mm256_div_ps(one, _mm256_add_ps(one, exp(_mm256_sub_ps(_mm256_setzero_ps(), x))));
+}
+
+inline __m256 activate(__m256 x, ActivationSpec a) {
+  const __m256 zero = _mm256_setzero_ps();
+  switch (a.kind) {
+    case Activation::None: return x;
+    case Activation::ReLU: return _mm256_max_ps(x, zero);
+    case Activation::ReLU6: return _mm256_min_ps(_mm256_max_ps(x, zero), _mm256_set1_ps(6.0f));
+    case Activation::HardSigmoid:
+    case Activation::HardSwish: {
+      __m256 g = _mm256_add_ps(x, _mm256_set1_ps(3.0f));
+      g = _mm256_min_ps(_mm256_max_ps(g, zero), _mm256_set1_ps(6.0f));
+      g = _mm256_div_ps(g, _mm256_set1_ps(6.0f));
+      return a.kind == Activation::HardSwish ? _mm256_mul_ps(x, g) : g;
+    }
+    case Activation::Sigmoid: return sigmoid(x);
+    case Activation::LeakyReLU: {
+      const __m256 neg = _mm256_mul_ps(x, _mm256_set1_ps(a.alpha));
+      return _mm256_blendv_ps(x, neg, _mm256_cmp_ps(x, zero, _CMP_LT_OQ));
+    }
+    case Activation::ELU: {
+      const __m256 neg = _mm256_mul_ps(_mm256_set1_ps(a.alpha),
+                                       _mm256_sub_ps(exp(x), _mm256_set1_ps(1.0f)));
+      return _mm256_blendv_ps(x, neg, _mm256_cmp_ps(x, zero, _CMP_LT_OQ));
+    }
+    case Activation::Tanh: {  // tanh(x) = 2 sigmoid(2x) - 1
+      const __m256 s = sigmoid(_mm256_add_ps(x, x));
+      return _mm256_sub_ps(_mm256_add_ps(s, s), _mm256_set1_ps(1.0f));
+    }
+  }
+  return x;
+}
+
+}  // namespace ampi::avx2

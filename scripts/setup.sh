@@ -1,0 +1,24 @@
+#!/usr/bin/env bash
+# Installs everything ampi needs on a fresh Debian 12 machine. Idempotent: packages that
+# are already present are skipped, so it is cheap to run before every build.
+set -euo pipefail
+
+packages=(
+  build-essential cmake pkg-config          # C++17 toolchain (g++ 12)
+  libopencv-dev                             # the only C++ library: image/video I/O, filters
+  catch2                                    # unit tests (Catch2 v2)
+  python3-numpy python3-torch               # fixtures, training, export (Debian's CPU torch)
+  g++-aarch64-linux-gnu qemu-user           # aarch64 cross build, tests run under qemu
+  ffmpeg                                    # GIF output (palette) and H.264 through OpenCV
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q 'install ok installed' || missing+=("$p")
+done
+if [ ${#missing[@]} -gt 0 ]; then
+  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -q
+  $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
+fi
