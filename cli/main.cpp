@@ -17,6 +17,7 @@ struct Command {
 
 const Command kCommands[] = {
     {"info", ampi::cli::cmd_info, "print a weight file's metadata and tensor table"},
+    {"bench", ampi::cli::cmd_bench, "kernel, network, renderer and pipeline latency"},
 };
 
 void print_usage(FILE* out) {

@@ -1,0 +1,42 @@
+// ampi bench WHAT: latency benchmarks. Each benchmark lives in bench/ and writes its
+// table into the repository (bench/RESULTS-*.md) as well as to stdout.
+#include <cstdio>
+#include <cstring>
+
+#include "bench/bench.h"
+#include "cli/commands.h"
+
+namespace ampi::cli {
+namespace {
+
+struct Benchmark {
+  const char* name;
+  int (*run)(int argc, char** argv);
+  const char* summary;
+};
+
+const Benchmark kBenchmarks[] = {
+    {nullptr, nullptr, nullptr},  // helpers add entries above this line
+};
+
+void usage(FILE* out) {
+  std::fprintf(out, "usage: ampi bench WHAT [OPTIONS]\n\nbenchmarks:\n");
+  for (const Benchmark& b : kBenchmarks)
+    if (b.name) std::fprintf(out, "  %-10s %s\n", b.name, b.summary);
+}
+
+}  // namespace
+
+int cmd_bench(int argc, char** argv) {
+  if (argc < 2 || !std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h")) {
+    usage(argc < 2 ? stderr : stdout);
+    return argc < 2 ? 2 : 0;
+  }
+  for (const Benchmark& b : kBenchmarks)
+    if (b.name && !std::strcmp(argv[1], b.name)) return b.run(argc - 1, argv + 1);
+  std::fprintf(stderr, "ampi bench: unknown benchmark '%s'\n", argv[1]);
+  usage(stderr);
+  return 2;
+}
+
+}  // namespace ampi::cli
