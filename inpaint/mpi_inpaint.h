@@ -1,0 +1,24 @@
+// Filling each MPI layer's occluded margin before rendering, so rendering never has to
+// invent pixels. The filler is pluggable: the inpainting network, or push-pull.
+#pragma once
+#include <functional>
+
+#include "inpaint/occlusion_mask.h"
+#include "mpi/mpi.h"
+
+namespace ampi {
+
+// Fills the colour of `image` (CV_8UC4) where `fill` != 0, from the pixels where
+// `known` != 0. Must leave every other pixel unchanged.
+using LayerFiller =
+    std::function<cv::Mat(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill)>;
+
+// The push-pull filler (inpaint/push_pull.h).
+LayerFiller push_pull_filler();
+
+// For every layer: computes its occlusion mask, fills those pixels with `filler` from
+// the layer's own pixels, and makes them opaque. Pixels outside the masks are untouched,
+// so transparent regions stay transparent. Returns the number of pixels filled.
+int64_t inpaint_mpi(Mpi& mpi, const LayerFiller& filler, const OcclusionMaskParams& params = {});
+
+}  // namespace ampi
