@@ -1,0 +1,78 @@
+// ampi info FILE: what a weight file holds (version, metadata, tensor table, totals).
+// Opening the file validates all of it, so a damaged file ends in a one-line error.
+#include <algorithm>
+#include <array>
+#include <cstdio>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cli/commands.h"
+#include "weights_format/weight_file.h"
+
+namespace ampi::cli {
+namespace {
+
+const char kUsage[] =
+    "usage: ampi info FILE.ampw\n"
+    "\n"
+    "Validates a weight file (checksums, bounds, shapes) and prints its format version,\n"
+    "metadata, tensor table (name, dtype, shape, bytes) and totals.\n";
+
+template <size_t N>
+void print_table(const std::array<std::string, N>& header, const std::vector<std::array<std::string, N>>& rows) {
+  std::array<size_t, N> width{};
+  for (size_t c = 0; c < N; ++c) {
+    width[c] = header[c].size();
+    for (const auto& row : rows) width[c] = std::max(width[c], row[c].size());
+  }
+  auto print_row = [&](const std::array<std::string, N>& row) {
+    std::string line = " ";
+    for (size_t c = 0; c < N; ++c) {
+      line += " " + row[c];
+      if (c + 1 < N) line.append(width[c] - row[c].size(), ' ');
+    }
+    std::printf("%s\n", line.c_str());
+  };
+  print_row(header);
+  for (const auto& row : rows) print_row(row);
+}
+
+void print_info(const WeightFile& wf) {
+  std::printf("%s: AMPW version %d.%d\n", wf.path().c_str(), wf.version_major(), wf.version_minor());
+
+  const auto metadata = wf.metadata_rows();
+  std::printf("\nmetadata (%zu entries):\n", metadata.size());
+  if (!metadata.empty()) print_table<3>({"key", "type", "value"}, metadata);
+
+  std::vector<std::array<std::string, 4>> tensor_rows;
+  int64_t parameters = 0;
+  uint64_t bytes = 0;
+  for (const TensorInfo& t : wf.tensors()) {
+    tensor_rows.push_back({t.name, dtype_name(t.dtype), shape_str(t.shape), std::to_string(t.bytes)});
+    parameters += shape_numel(t.shape);
+    bytes += t.bytes;
+  }
+  std::printf("\ntensors (%zu):\n", tensor_rows.size());
+  if (!tensor_rows.empty()) print_table<4>({"name", "dtype", "shape", "bytes"}, tensor_rows);
+  std::printf("\ntotal: %lld parameters, %llu bytes of tensor data\n", static_cast<long long>(parameters),
+              static_cast<unsigned long long>(bytes));
+}
+
+}  // namespace
+
+int cmd_info(int argc, char** argv) {
+  if (argc == 2 && (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h"))) {
+    std::fputs(kUsage, stdout);
+    return 0;
+  }
+  if (argc != 2 || argv[1][0] == '-') {
+    std::fputs("ampi info: expected one weight file (usage: ampi info FILE.ampw)\n", stderr);
+    return 2;
+  }
+  print_info(WeightFile::open(argv[1]));
+  return 0;
+}
+
+}  // namespace ampi::cli
