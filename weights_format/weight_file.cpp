@@ -7,7 +7,7 @@
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
-#include <unordered_set>
+#include <tuple>
 
 #include "engine/half.h"
 #include "weights_format/crc32.h"
@@ -402,7 +402,10 @@ void WeightFile::check_overlaps() const {
   std::vector<const TensorInfo*> by_offset;
   for (const TensorInfo& t : tensors_) by_offset.push_back(&t);
   std::sort(by_offset.begin(), by_offset.end(),
-            [](const TensorInfo* a, const TensorInfo* b) { return a->offset < b->offset; });
+            [](const TensorInfo* a, const TensorInfo* b) {
+              // Ties broken like the Python reader, so both name the same pair.
+              return std::tie(a->offset, a->bytes, a->name) < std::tie(b->offset, b->bytes, b->name);
+            });
   for (size_t i = 1; i < by_offset.size(); ++i) {
     const TensorInfo& a = *by_offset[i - 1];
     const TensorInfo& b = *by_offset[i];
