@@ -1,15 +1,14 @@
 #include "weights_format/weight_file.h"
 
 #include <algorithm>
-#include <cerrno>
 #include <charconv>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <stdexcept>
 #include <tuple>
 
 #include "engine/half.h"
+#include "weights_format/binary_io.h"
 #include "weights_format/crc32.h"
 
 // Tensor data is handed out with memcpy, which is only right where the host's byte order
@@ -234,24 +233,15 @@ std::string value_text(const MetaValue& value) {
   return "";
 }
 
+// Checks the preamble before loading the rest, so that a large file of another kind is
+// rejected without being read.
 std::vector<uint8_t> read_ampw_file(const std::string& path) {
-  std::error_code ec;
-  const auto status = std::filesystem::status(path, ec);
-  if (ec || !std::filesystem::exists(status)) fail_at(path, "cannot open: no such file");
-  if (!std::filesystem::is_regular_file(status)) fail_at(path, "cannot open: not a regular file");
-  const uint64_t size = std::filesystem::file_size(path, ec);
-  if (ec) fail_at(path, "cannot open: " + ec.message());
-
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file(std::fopen(path.c_str(), "rb"), std::fclose);
-  if (!file) fail_at(path, std::string("cannot open: ") + std::strerror(errno));
-  std::vector<uint8_t> bytes(std::min<uint64_t>(size, kPreambleBytes));
-  if (std::fread(bytes.data(), 1, bytes.size(), file.get()) != bytes.size())
-    fail_at(path, "read error in the preamble");
-  check_identity(bytes.data(), size, path);
-  bytes.resize(size);
-  const size_t rest = size - kPreambleBytes;
-  if (std::fread(bytes.data() + kPreambleBytes, 1, rest, file.get()) != rest)
-    fail_at(path, "read error: the file shrank while it was read");
+  InputFile file(path);
+  std::vector<uint8_t> bytes(std::min<uint64_t>(file.size(), kPreambleBytes));
+  file.read(bytes.data(), bytes.size());
+  check_identity(bytes.data(), file.size(), path);
+  bytes.resize(file.size());
+  file.read(bytes.data() + kPreambleBytes, bytes.size() - kPreambleBytes);
   return bytes;
 }
 
