@@ -10,6 +10,10 @@ KernelTable build(Isa isa) {
   KernelTable table;
   fill_scalar_kernels(table);
   table.isa = isa;
+  // The fill functions are compiled with their ISA's flags, so even filling the table may
+  // execute that ISA's instructions (GCC stores the pointers with AVX-512 moves): never
+  // call one the CPU cannot run. kernels_for() never hands out such a table.
+  if (!isa_runnable(isa)) return table;
   switch (isa) {
     case Isa::Scalar: break;
 #if defined(AMPI_ARCH_X86)

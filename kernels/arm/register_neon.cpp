@@ -6,6 +6,15 @@ namespace ampi {
 void fill_neon_kernels(KernelTable& t) {
   t.add = neon::add;
   t.activate = neon::activate_inplace;
+  t.gated_output = neon::gated_output;
+  t.concat_channels = neon::concat_channels;
+  t.channel_sum = neon::channel_sum;
+  t.channel_scale = neon::channel_scale;
+  t.dense = neon::dense;
+  t.haar_dwt = neon::haar_dwt;
+  t.haar_idwt = neon::haar_idwt;
+  t.resize2x_nearest = neon::resize2x_nearest;
+  t.resize2x_bilinear = neon::resize2x_bilinear;
 }
 
 }  // namespace ampi

@@ -10,4 +10,17 @@ namespace ampi::avx512 {
 void add(const float* a, const float* b, int64_t n, ActivationSpec act, float* out);
 void activate_inplace(float* x, int64_t n, ActivationSpec act);
 
+// Channel operations (channels_avx512.cpp) and 2x resampling (resample_avx512.cpp); contracts
+// in kernels/kernel_table.h.
+void gated_output(const float* in, int64_t pixels, int c, ActivationSpec act, float* out);
+void concat_channels(const float* a, int ca, const float* b, int cb, int64_t pixels, float* out);
+void channel_sum(const float* in, int64_t pixels, int c, float* sum);
+void channel_scale(const float* in, int64_t pixels, int c, const float* scale, float* out);
+void dense(const float* w, const float* bias, int rows, int cols, const float* x,
+           ActivationSpec act, float* y);
+void haar_dwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+void haar_idwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+void resize2x_nearest(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+void resize2x_bilinear(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+
 }  // namespace ampi::avx512

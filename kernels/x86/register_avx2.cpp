@@ -6,6 +6,15 @@ namespace ampi {
 void fill_avx2_kernels(KernelTable& t) {
   t.add = avx2::add;
   t.activate = avx2::activate_inplace;
+  t.gated_output = avx2::gated_output;
+  t.concat_channels = avx2::concat_channels;
+  t.channel_sum = avx2::channel_sum;
+  t.channel_scale = avx2::channel_scale;
+  t.dense = avx2::dense;
+  t.haar_dwt = avx2::haar_dwt;
+  t.haar_idwt = avx2::haar_idwt;
+  t.resize2x_nearest = avx2::resize2x_nearest;
+  t.resize2x_bilinear = avx2::resize2x_bilinear;
 }
 
 }  // namespace ampi

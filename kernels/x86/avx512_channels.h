@@ -1,0 +1,36 @@
+// Loops over the channels of one NHWC pixel in 16-float vectors, the last one masked.
+// Include only from *_avx512.cpp files. Same pattern as avx2_channels.h.
+#pragma once
+#include <immintrin.h>
+
+namespace ampi::avx512 {
+
+// Loads and stores the lanes set in mask (masked-off loads read as 0 and never fault).
+struct MaskedVector {
+  __mmask16 mask;
+  __m512 load(const float* p) const { return _mm512_maskz_loadu_ps(mask, p); }
+  void store(float* p, __m512 v) const { _mm512_mask_storeu_ps(p, mask, v); }
+};
+
+struct FullVector {
+  __m512 load(const float* p) const { return _mm512_loadu_ps(p); }
+  void store(float* p, __m512 v) const { _mm512_storeu_ps(p, v); }
+};
+
+class Channels {
+ public:
+  explicit Channels(int c)
+      : c_(c), whole_(c - c % 16), tail_{static_cast<__mmask16>((1u << (c % 16)) - 1u)} {}
+  // Calls body(j, accessor) for j = 0, 16, 32, ... < c.
+  template <class Body>
+  void each(Body&& body) const {
+    for (int j = 0; j < whole_; j += 16) body(j, FullVector{});
+    if (whole_ < c_) body(whole_, tail_);
+  }
+
+ private:
+  int c_, whole_;
+  MaskedVector tail_;
+};
+
+}  // namespace ampi::avx512
