@@ -30,7 +30,8 @@ struct Plane {
   double depth = 1.0;         // distance z_j of the fronto-parallel plane (> 0)
   double disparity = 0.0;     // mean normalised disparity of its pixels, [0, 255]
   double disparity_lo = 0.0;  // interval [lo, hi) of normalised disparity it holds
-  double disparity_hi = 0.0;
+  double disparity_hi = 0.0;  // (a plane with disparity_hi = 255 also holds 255)
+  long long pixel_count = 0;  // pixels of the source disparity map the plane holds
 };
 
 struct Mpi {
