@@ -122,7 +122,8 @@ def _encode_tensor_data(name, array, as_f16):
     if 0 in arr.shape:
         raise AmpwError("tensor '%s': dimension %d is 0" % (name, arr.shape.index(0)))
     dtype = DTYPE_F16 if as_f16 else DTYPE_F32
-    stored = arr.astype(DTYPES[dtype], order="C")  # unlike ascontiguousarray, keeps rank 0
+    with np.errstate(over="ignore"):  # overflow is reported below, by name
+        stored = arr.astype(DTYPES[dtype], order="C")  # unlike ascontiguousarray, keeps rank 0
     overflow = np.isfinite(arr) & ~np.isfinite(stored)
     if overflow.any():
         raise AmpwError("tensor '%s': %d values overflow %s" % (name, int(overflow.sum()), "f16" if as_f16 else "f32"))
