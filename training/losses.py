@@ -1,0 +1,72 @@
+"""The depth loss of the paper (section "Implementation details"):
+
+    L       = L_data + 0.5 * L_grad                     for each output, summed over outputs
+    L_data  = mean |y^ - y|
+    L_grad  = sum_{s=0..3} mean |grad_x(y^_s - y_s)| + mean |grad_y(y^_s - y_s)|
+
+where y is the target disparity normalised per image to [0, 10] and brought to the
+output's resolution, and y^_s, y_s are prediction and target down-scaled by 2^s. The
+down-scaling is a 2^s x 2^s average (area) pooling; since it is linear, pooling the
+difference equals the difference of the pooled maps. A scale whose map would be smaller
+than 2 pixels on a side has no gradient to measure and is skipped (only on tiny inputs).
+"""
+from __future__ import annotations
+
+import torch
+import torch.nn.functional as F
+
+GRAD_WEIGHT = 0.5
+GRAD_SCALES = 4
+TARGET_RANGE = 10.0
+
+
+def normalise_target(disparity: torch.Tensor, eps: float = 1e-6) -> torch.Tensor:
+    """Per-image min-max to [0, TARGET_RANGE]; [N, 1, H, W]. A constant map becomes 0."""
+    flat = disparity.flatten(1)
+    lo = flat.min(dim=1).values.view(-1, 1, 1, 1)
+    hi = flat.max(dim=1).values.view(-1, 1, 1, 1)
+    return TARGET_RANGE * (disparity - lo) / (hi - lo).clamp_min(eps)
+
+
+def resize_target(target: torch.Tensor, size) -> torch.Tensor:
+    """Area down-scaling of the target to an output's (h, w), an integer factor."""
+    if tuple(target.shape[-2:]) == tuple(size):
+        return target
+    factor = target.shape[-2] // size[0]
+    if factor * size[0] != target.shape[-2] or factor * size[1] != target.shape[-1]:
+        raise ValueError(f"target {tuple(target.shape[-2:])} is not an integer multiple of {tuple(size)}")
+    return F.avg_pool2d(target, factor)
+
+
+def gradient_loss(diff: torch.Tensor, scales: int = GRAD_SCALES) -> torch.Tensor:
+    total = diff.new_zeros(())
+    for s in range(scales):
+        d = F.avg_pool2d(diff, 2 ** s) if s else diff
+        if d.shape[-1] < 2 or d.shape[-2] < 2:
+            break
+        total = total + (d[..., :, 1:] - d[..., :, :-1]).abs().mean()
+        total = total + (d[..., 1:, :] - d[..., :-1, :]).abs().mean()
+    return total
+
+
+def output_loss(pred: torch.Tensor, target: torch.Tensor):
+    """(L, L_data, L_grad) for one output and a target already at its resolution."""
+    diff = pred - target
+    data = diff.abs().mean()
+    grad = gradient_loss(diff)
+    return data + GRAD_WEIGHT * grad, data, grad
+
+
+def depth_loss(outputs, disparity: torch.Tensor):
+    """Sum of the per-output losses. outputs: the network's list of [N, 1, h, w] maps;
+    disparity: the raw target [N, 1, H, W] at the finest output's size. Returns the total
+    and a dict of the parts (floats) for the log."""
+    target = normalise_target(disparity)
+    total = disparity.new_zeros(())
+    parts = {"data": 0.0, "grad": 0.0}
+    for pred in outputs:
+        loss, data, grad = output_loss(pred, resize_target(target, pred.shape[-2:]))
+        total = total + loss
+        parts["data"] += float(data)
+        parts["grad"] += float(grad)
+    return total, parts

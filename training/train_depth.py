@@ -1,0 +1,270 @@
+"""Trains the depth network (lite or heavy) on (image, disparity) pairs.
+
+    /usr/bin/python3 training/train_depth.py --model lite --run training/runs/lite \
+        --data scenes --size 256x192 --batch 4 --steps 20000
+
+The paper's recipe: Adam at 1e-3, learning rate x0.2 when the validation loss plateaus,
+the loss of training/losses.py on all four outputs. Runs are resumable: the run folder
+holds `checkpoint.pt` (model, optimiser, scheduler, step, best validation loss), written
+atomically every --checkpoint-every steps, and `train.log`, one text line per logged step
+and per validation. Starting again with the same --run continues where it stopped.
+
+Data sources (--data), all yielding (rgb, disparity) pairs, rgb in [0, 1]:
+  scenes       the procedural RGB-D generator of training/scenes.py (exact disparity)
+  cards        the small built-in generator of training/card_scenes.py (exact disparity)
+  pairs:DIR    a folder of photos NAME.jpg|png with disparity maps NAME.npy beside them
+               (what training/distill.py writes for pseudo-labelled photos)
+Validation uses a disjoint fixed set: scene seeds from VAL_SEED_START, or every tenth
+pair by sorted name (never trained on).
+"""
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import random
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import depth_model  # noqa: E402
+import losses  # noqa: E402
+
+VAL_SEED_START = 1_000_000_000  # synthetic validation scenes; training seeds stay below
+VAL_EVERY_TENTH = 10
+
+
+# ---- data sources -------------------------------------------------------------------------
+
+def to_tensors(rgb, disparity):
+    """Accepts numpy (H x W x 3 uint8 or float in [0, 1]; H x W disparity) or torch
+    (3 x H x W, 1 x H x W) and returns float32 tensors [3, H, W] and [1, H, W]."""
+    if isinstance(rgb, np.ndarray):
+        scale = 1.0 / 255.0 if rgb.dtype == np.uint8 else 1.0
+        rgb = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1).float() * scale
+    if isinstance(disparity, np.ndarray):
+        disparity = torch.from_numpy(np.ascontiguousarray(disparity, dtype=np.float32))
+    if disparity.dim() == 2:
+        disparity = disparity.unsqueeze(0)
+    return rgb.float(), disparity.float()
+
+
+class SceneSource:
+    """Procedural scenes by seed (issue 5's generator, training/scenes.py)."""
+
+    def __init__(self, size):
+        import scenes  # the generator lives beside this file
+        self.scenes = scenes
+        self.width, self.height = size
+
+    def sample(self, index: int, validation: bool):
+        seed = (VAL_SEED_START if validation else 0) + index
+        return to_tensors(*self.scenes.render_scene(seed, self.width, self.height))
+
+    def validation_count(self, wanted: int) -> int:
+        return wanted
+
+
+class CardSource:
+    """The small built-in generator (training/card_scenes.py): cards on a ground plane."""
+
+    def __init__(self, size):
+        import card_scenes
+        self.render = card_scenes.CardScenes(*size)
+
+    def sample(self, index: int, validation: bool):
+        return to_tensors(*self.render((VAL_SEED_START if validation else 0) + index))
+
+    def validation_count(self, wanted: int) -> int:
+        return wanted
+
+
+class PairFolderSource:
+    """Photos with disparity maps beside them (NAME.npy), resized to the training size.
+    Every tenth pair by sorted name is the validation split."""
+
+    def __init__(self, folder: str, size):
+        self.width, self.height = size
+        images = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in (".jpg", ".jpeg", ".png"))
+        pairs = [(p, p.with_suffix(".npy")) for p in images if p.with_suffix(".npy").exists()]
+        if not pairs:
+            raise FileNotFoundError(f"{folder}: no image with a NAME.npy disparity beside it")
+        self.val = pairs[::VAL_EVERY_TENTH]
+        self.train = [p for i, p in enumerate(pairs) if i % VAL_EVERY_TENTH]
+
+    def _load(self, pair):
+        from PIL import Image  # Debian's python3-pil
+        image = Image.open(pair[0])
+        image = np.asarray(image.convert("RGB").resize((self.width, self.height), Image.BILINEAR))
+        rgb, disparity = to_tensors(image, np.load(pair[1]).astype(np.float32))
+        disparity = F.interpolate(disparity[None], size=(self.height, self.width), mode="bilinear",
+                                  align_corners=False)[0]
+        return rgb, disparity
+
+    def sample(self, index: int, validation: bool):
+        pairs = self.val if validation else self.train
+        return self._load(pairs[index % len(pairs)])
+
+    def validation_count(self, wanted: int) -> int:
+        return min(wanted, len(self.val))
+
+
+def make_source(spec: str, size):
+    if spec == "scenes":
+        return SceneSource(size)
+    if spec == "cards":
+        return CardSource(size)
+    if spec.startswith("pairs:"):
+        return PairFolderSource(spec[len("pairs:"):], size)
+    raise ValueError(f"unknown data source {spec!r} (scenes | cards | pairs:DIR)")
+
+
+def make_batch(source, first_index: int, batch: int, validation: bool, rng: random.Random):
+    rgbs, disps = [], []
+    for i in range(batch):
+        rgb, disp = source.sample(first_index + i, validation)
+        if not validation and rng.random() < 0.5:  # horizontal flip: a free, exact augmentation
+            rgb, disp = rgb.flip(-1), disp.flip(-1)
+        rgbs.append(rgb)
+        disps.append(disp)
+    return (torch.stack(rgbs).contiguous(memory_format=torch.channels_last),
+            torch.stack(disps))
+
+
+# ---- metrics ------------------------------------------------------------------------------
+
+def aligned_delta1(pred: torch.Tensor, target: torch.Tensor) -> float:
+    """The paper's delta < 1.25 after median and standard-deviation alignment of the
+    prediction to the (normalised, strictly positive) target, averaged over the batch."""
+    scores = []
+    for p, t in zip(pred.flatten(1), losses.normalise_target(target).flatten(1) + 1.0):
+        p = (p - p.median()) / p.std().clamp_min(1e-6) * t.std() + t.median()
+        p = p.clamp_min(1e-3)
+        ratio = torch.maximum(p / t, t / p)
+        scores.append(float((ratio < 1.25).float().mean()))
+    return float(np.mean(scores))
+
+
+@torch.no_grad()
+def validate(model, source, count: int, batch: int):
+    model.eval()
+    total, delta, batches = 0.0, 0.0, 0
+    for first in range(0, count, batch):
+        rgb, disp = make_batch(source, first, min(batch, count - first), True, random.Random(0))
+        outputs = model(rgb)
+        loss, _ = losses.depth_loss(outputs, disp)
+        total += float(loss)
+        delta += aligned_delta1(outputs[-1], disp)
+        batches += 1
+    model.train()
+    return total / batches, delta / batches
+
+
+# ---- checkpoints --------------------------------------------------------------------------
+
+def save_checkpoint(path: Path, state: dict):
+    tmp = path.with_suffix(".tmp")
+    torch.save(state, tmp)
+    os.replace(tmp, path)  # a crash mid-write never leaves a torn checkpoint
+
+
+def log_line(run: Path, text: str):
+    line = time.strftime("%Y-%m-%d %H:%M:%S ") + text
+    print(line, flush=True)
+    with open(run / "train.log", "a") as f:
+        f.write(line + "\n")
+
+
+def parse_size(text: str):
+    w, h = (int(v) for v in text.lower().split("x"))
+    return w, h
+
+
+def train(args):
+    torch.set_num_threads(args.threads)
+    torch.manual_seed(args.seed)
+    run = Path(args.run)
+    run.mkdir(parents=True, exist_ok=True)
+    size = parse_size(args.size)
+    model = depth_model.build(args.model)
+    if size[0] % model.multiple or size[1] % model.multiple:
+        raise SystemExit(f"--size {args.size}: both sides must be multiples of {model.multiple}")
+    model = model.to(memory_format=torch.channels_last)
+    optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
+    scheduler = torch.optim.lr_scheduler.ReduceLROnPlateau(
+        optimiser, factor=0.2, patience=args.patience)
+    step, best = 0, math.inf
+    ckpt_path = run / "checkpoint.pt"
+    if ckpt_path.exists():
+        ckpt = torch.load(ckpt_path)
+        if ckpt["model_name"] != args.model:
+            raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
+        model.load_state_dict(ckpt["model"])
+        optimiser.load_state_dict(ckpt["optimiser"])
+        scheduler.load_state_dict(ckpt["scheduler"])
+        step, best = ckpt["step"], ckpt["best_val"]
+        log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}")
+    elif args.init:
+        model.load_state_dict(torch.load(args.init)["model"])
+        log_line(run, f"initialised {args.model} from {args.init}")
+    source = make_source(args.data, size)
+    val_count = source.validation_count(args.val_count)
+    log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data} "
+                  f"at {size[0]}x{size[1]}, batch {args.batch}, {args.threads} threads")
+
+    def checkpoint():
+        save_checkpoint(ckpt_path, {
+            "model_name": args.model, "model": model.state_dict(), "optimiser": optimiser.state_dict(),
+            "scheduler": scheduler.state_dict(), "step": step, "best_val": best})
+
+    rng = random.Random(args.seed)
+    t0, seen = time.time(), 0
+    while step < args.steps:
+        rng.seed(args.seed * 1_000_003 + step)  # resumed runs draw the same flips
+        rgb, disp = make_batch(source, step * args.batch, args.batch, False, rng)
+        loss, parts = losses.depth_loss(model(rgb), disp)
+        optimiser.zero_grad(set_to_none=True)
+        loss.backward()
+        optimiser.step()
+        step += 1
+        seen += 1
+        if step % args.log_every == 0:
+            log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
+                          f"lr {optimiser.param_groups[0]['lr']:.2e} {(time.time() - t0) / seen:.2f} s/step")
+        if step % args.val_every == 0 or step == args.steps:
+            val_loss, delta1 = validate(model, source, val_count, args.batch)
+            scheduler.step(val_loss)
+            best = min(best, val_loss)
+            log_line(run, f"val step {step} loss {val_loss:.4f} delta1.25 {delta1:.4f} best {best:.4f}")
+        if step % args.checkpoint_every == 0 or step == args.steps:
+            checkpoint()
+    log_line(run, f"done at step {step}")
+
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--model", choices=sorted(depth_model.ARCHITECTURES), default="lite")
+    p.add_argument("--run", required=True, help="run folder: checkpoint.pt and train.log")
+    p.add_argument("--data", default="scenes", help="scenes | cards | pairs:DIR")
+    p.add_argument("--size", default="256x192", help="WIDTHxHEIGHT, multiples of 32")
+    p.add_argument("--batch", type=int, default=4)
+    p.add_argument("--steps", type=int, default=20000, help="total steps (a resumed run continues to this)")
+    p.add_argument("--lr", type=float, default=1e-3)
+    p.add_argument("--patience", type=int, default=5, help="validations without improvement before lr x0.2")
+    p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--seed", type=int, default=1)
+    p.add_argument("--log-every", type=int, default=10)
+    p.add_argument("--val-every", type=int, default=200)
+    p.add_argument("--val-count", type=int, default=32)
+    p.add_argument("--checkpoint-every", type=int, default=50)
+    p.add_argument("--init", help="start from this checkpoint's weights (fine-tuning)")
+    train(p.parse_args(argv))
+
+
+if __name__ == "__main__":
+    main()
