@@ -1,0 +1,245 @@
+#!/usr/bin/env python3
+"""Tests of the procedural RGB-D scene generator (training/scenes.py).
+
+Run: /usr/bin/python3 training/test_scenes.py (ctest runs it as training_scenes)."""
+
+import math
+import os
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+import torch
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import scenes  # noqa: E402
+from scenes import (Atmosphere, Box, Camera, Light, Material, Quad, Scene, SceneObject,  # noqa: E402
+                    Sphere, ground_plane)
+
+SMALL = (96, 72)
+SEEDS = (0, 1, 2, 3, 4, 5, 6, 7, 10 ** 9, 10 ** 9 + 1)
+
+RED = np.array([0.6, 0.05, 0.05], dtype=np.float32)
+BLUE = np.array([0.05, 0.05, 0.6], dtype=np.float32)
+GREY = np.array([0.3, 0.3, 0.3], dtype=np.float32)
+GREEN = np.array([0.05, 0.6, 0.05], dtype=np.float32)
+
+
+def level_camera(width=160, height=120, eye_height=1.5):
+    return Camera(width, height, fov_x_deg=60.0, position=np.array([0.0, eye_height, 0.0]))
+
+
+def pixel_of(camera, point):
+    """(row, col) of a world point seen by a level camera (no pitch, roll or yaw)."""
+    x, y, z = np.asarray(point, dtype=np.float64) - camera.position
+    col = camera.focal * x / z + camera.width / 2 - 0.5
+    row = camera.focal * -y / z + camera.height / 2 - 0.5
+    return int(round(row)), int(round(col))
+
+
+def plain_scene(camera, objects, sun_direction=(0.0, 1.0, 0.0)):
+    light = Light(np.asarray(sun_direction, dtype=np.float64), np.full(3, 2.0, np.float32),
+                  np.full(3, 0.3, np.float32))
+    atmosphere = Atmosphere(np.array([0.1, 0.2, 0.6], np.float32), np.array([0.6, 0.7, 0.8], np.float32), 0.0)
+    return Scene(camera, objects, light, atmosphere)
+
+
+def wall_and_box_scene(box_first=False):
+    """A box (front face at z = 3.5) at eye height in front of a wall at z = 10."""
+    camera = level_camera()
+    ground = SceneObject(ground_plane(), Material(GREY), False)
+    wall = SceneObject(Quad((0, 0, 10), (1, 0, 0), (0, 1, 0), np.inf, np.inf), Material(BLUE), False)
+    box = SceneObject(Box((0, 1.5, 4), (0.5, 0.5, 0.5)), Material(RED))
+    sphere = SceneObject(Sphere((0.7, 1.5, 6), 0.5), Material(GREEN))
+    objects = [box, sphere, ground, wall] if box_first else [ground, wall, sphere, box]
+    return plain_scene(camera, objects)
+
+
+class HandBuiltScenes(unittest.TestCase):
+    def test_box_occludes_wall_with_exact_disparity(self):
+        scene = wall_and_box_scene()
+        radiance, disparity = scenes.render(scene)
+        box_pixel = pixel_of(scene.camera, (0, 1.5, 3.5))
+        wall_pixel = pixel_of(scene.camera, (-3, 2.5, 10))
+        self.assertAlmostEqual(float(disparity[box_pixel]), 1 / 3.5, places=5)
+        self.assertAlmostEqual(float(disparity[wall_pixel]), 1 / 10, places=6)
+        self.assertGreater(disparity[box_pixel], disparity[wall_pixel])
+        red, _, blue = radiance[:, box_pixel[0], box_pixel[1]]
+        self.assertGreater(red, 3 * blue, 'the box, not the wall behind it, must give the colour')
+        red, _, blue = radiance[:, wall_pixel[0], wall_pixel[1]]
+        self.assertGreater(blue, 3 * red)
+
+    def test_nearer_box_hides_part_of_the_sphere_behind_it(self):
+        scene = wall_and_box_scene()
+        _, disparity = scenes.render(scene)
+        hidden = pixel_of(scene.camera, (0.4, 1.5, 3.5))      # on the box, in front of the sphere
+        visible = pixel_of(scene.camera, (1.1, 1.5, 6.0))     # the sphere's right side, beside the box
+        self.assertAlmostEqual(float(disparity[hidden]), 1 / 3.5, places=5)
+        self.assertGreater(disparity[visible], 1 / 6.5)
+        self.assertLess(disparity[visible], 1 / 5.0)
+
+    def test_drawing_order_does_not_matter(self):
+        _, first = scenes.render(wall_and_box_scene(box_first=False))
+        _, second = scenes.render(wall_and_box_scene(box_first=True))
+        np.testing.assert_array_equal(first, second)
+
+    def test_ground_disparity_is_exact_and_grows_downwards(self):
+        camera = level_camera(eye_height=2.0)
+        scene = plain_scene(camera, [SceneObject(ground_plane(), Material(GREY), False)])
+        _, disparity = scenes.render(scene)
+        rows = np.arange(camera.height)
+        below = rows + 0.5 > camera.height / 2
+        expected = (rows[below] + 0.5 - camera.height / 2) / camera.focal / 2.0   # y_n / eye height
+        np.testing.assert_allclose(disparity[below, 0], expected, rtol=1e-5)
+        self.assertTrue(np.all(np.diff(disparity[below, 0]) > 0), 'ground must recede upwards')
+        self.assertTrue(np.all(disparity[~below] == 0), 'above the horizon is sky: disparity 0')
+
+    def test_box_casts_a_shadow_on_the_ground(self):
+        camera = level_camera()
+        ground = SceneObject(ground_plane(), Material(GREY), False)
+        box = SceneObject(Box((0, 0.6, 4), (0.3, 0.3, 0.3)), Material(RED))
+        radiance, _ = scenes.render(plain_scene(camera, [ground, box], sun_direction=(0, 1, 0)))
+        shaded = radiance[:, pixel_of(camera, (0, 0, 4.2))[0], pixel_of(camera, (0, 0, 4.2))[1]]
+        sunlit = radiance[:, pixel_of(camera, (1.5, 0, 4.2))[0], pixel_of(camera, (1.5, 0, 4.2))[1]]
+        self.assertLess(shaded.sum() * 2, sunlit.sum())
+
+    def test_cutout_mask_lets_the_background_through(self):
+        camera = level_camera()
+        wall = SceneObject(Quad((0, 0, 10), (1, 0, 0), (0, 1, 0), np.inf, np.inf), Material(BLUE), False)
+        mask = np.zeros((4, 4), dtype=bool)
+        mask[:, :2] = True                                     # only the left half is solid
+        cutout = SceneObject(Quad((0, 1.5, 5), (1, 0, 0), (0, 1, 0), 1.0, 1.0, mask), Material(RED))
+        _, disparity = scenes.render(plain_scene(camera, [wall, cutout]))
+        self.assertAlmostEqual(float(disparity[pixel_of(camera, (-0.5, 1.5, 5))]), 0.2, places=5)
+        self.assertAlmostEqual(float(disparity[pixel_of(camera, (0.5, 1.5, 5))]), 0.1, places=6)
+
+
+class RandomScenes(unittest.TestCase):
+    def test_same_seed_same_images(self):
+        for seed in (3, 10 ** 9 + 3):
+            with self.subTest(seed=seed):
+                rgb_a, disparity_a = scenes.render_scene(seed, *SMALL)
+                rgb_b, disparity_b = scenes.render_scene(seed, *SMALL)
+                np.testing.assert_array_equal(rgb_a, rgb_b)
+                np.testing.assert_array_equal(disparity_a, disparity_b)
+        rgb_other, _ = scenes.render_scene(4, *SMALL)
+        self.assertFalse(np.array_equal(rgb_other, scenes.render_scene(3, *SMALL)[0]))
+
+    def test_shapes_and_types(self):
+        rgb, disparity = scenes.render_scene(11, 64, 40)
+        self.assertEqual(rgb.shape, (40, 64, 3))
+        self.assertEqual(rgb.dtype, np.uint8)
+        self.assertEqual(disparity.shape, (40, 64))
+        self.assertEqual(disparity.dtype, np.float32)
+
+    def test_disparity_positive_where_not_sky_and_zero_in_sky(self):
+        for seed in SEEDS:
+            with self.subTest(seed=seed):
+                scene = scenes.sample_scene(seed, *SMALL)
+                gbuffer = scenes.raycast(scene)
+                _, disparity = scenes.render_scene(seed, *SMALL)
+                surface = gbuffer.ids >= 0
+                self.assertTrue(np.all(np.isfinite(disparity)))
+                self.assertTrue(np.all(disparity[surface] > 0))
+                self.assertTrue(np.all(disparity[~surface] == 0))
+                self.assertLess(float(disparity.max()), 1 / scenes.NEAR_CLIP + 1e-3)
+                np.testing.assert_array_equal(disparity, scenes.disparity_of(gbuffer))
+
+    def test_scenes_are_varied(self):
+        counts = [len(scenes.sample_scene(seed, *SMALL).objects) for seed in range(8)]
+        self.assertGreater(min(counts), 4, f'objects per scene: {counts}')
+        shapes = {type(o.shape).__name__ for seed in range(8) for o in scenes.sample_scene(seed, *SMALL).objects}
+        self.assertEqual(shapes, {'Box', 'Sphere', 'Cylinder', 'Quad'})
+
+    def test_images_are_not_flat(self):
+        for seed in SEEDS[:4]:
+            with self.subTest(seed=seed):
+                rgb, _ = scenes.render_scene(seed, *SMALL)
+                self.assertGreater(float(rgb.std()), 8.0)
+
+
+class ValidationSplit(unittest.TestCase):
+    def test_seed_split(self):
+        self.assertFalse(scenes.is_validation_seed(0))
+        self.assertFalse(scenes.is_validation_seed(10 ** 9 - 1))
+        self.assertTrue(scenes.is_validation_seed(10 ** 9))
+
+    def test_every_tenth_photo_of_each_folder_is_validation(self):
+        photos = scenes.list_photos()
+        train, val = scenes.list_photos('train'), scenes.list_photos('val')
+        self.assertFalse(set(train) & set(val))
+        self.assertEqual(sorted(train + val), photos)
+        folders = {p.parent for p in photos}
+        expected = sum(len([p for p in photos if p.parent == f]) // 10 for f in folders)
+        self.assertEqual(len(val), expected)
+        first_folder = sorted(p for p in photos if p.parent == sorted(folders)[0])
+        self.assertEqual(scenes.photo_split(first_folder[9]), 'val')
+        self.assertEqual(scenes.photo_split(first_folder[8]), 'train')
+
+    def test_texture_pools_are_disjoint_and_used_by_their_seeds(self):
+        train, val = scenes.texture_pool('train'), scenes.texture_pool('val')
+        self.assertFalse(set(train.paths) & set(val.paths))
+        for seed, pool in ((5, train), (10 ** 9 + 5, val)):
+            with self.subTest(seed=seed):
+                owned = {id(p) for p in pool.pyramids}
+                used = {id(o.material.pyramid) for o in scenes.sample_scene(seed, *SMALL).objects
+                        if o.material.pyramid is not None}
+                self.assertTrue(used)
+                self.assertLessEqual(used, owned)
+
+    def test_bad_paths_are_named_in_the_error(self):
+        with self.assertRaisesRegex(ValueError, 'notes.txt'):
+            scenes.photo_split(scenes.photo_root() / 'kodak24' / 'notes.txt')
+        with tempfile.TemporaryDirectory() as empty:
+            missing = os.path.join(empty, 'nowhere')
+            with self.assertRaisesRegex(RuntimeError, 'nowhere'):
+                scenes.list_photos(root=missing)
+            with self.assertRaisesRegex(RuntimeError, 'no train photos'):
+                scenes.list_photos('train', root=empty)
+
+
+class Dataset(unittest.TestCase):
+    def test_items_are_tensors_of_the_requested_size(self):
+        dataset = scenes.SceneDataset(20, 3, (64, 48))
+        self.assertEqual(len(dataset), 3)
+        image, disparity = dataset[2]
+        self.assertEqual(image.shape, (3, 48, 64))
+        self.assertEqual(disparity.shape, (1, 48, 64))
+        self.assertEqual(image.dtype, torch.float32)
+        self.assertTrue(0 <= float(image.min()) and float(image.max()) <= 1)
+        expected_rgb, expected_disparity = scenes.render_scene(22, 64, 48)
+        np.testing.assert_array_equal(disparity[0].numpy(), expected_disparity)
+        np.testing.assert_allclose(image.permute(1, 2, 0).numpy() * 255, expected_rgb, atol=1e-3)
+        with self.assertRaises(IndexError):
+            dataset[3]
+
+    def test_a_range_may_not_mix_training_and_validation_seeds(self):
+        with self.assertRaisesRegex(ValueError, 'mix'):
+            scenes.SceneDataset(10 ** 9 - 1, 2)
+
+    def test_dataloader_with_a_worker(self):
+        loader = torch.utils.data.DataLoader(scenes.SceneDataset(30, 4, (48, 32)), batch_size=2, num_workers=1)
+        batches = list(loader)
+        self.assertEqual(len(batches), 2)
+        self.assertEqual(tuple(batches[0][0].shape), (2, 3, 32, 48))
+        _, expected = scenes.render_scene(33, 48, 32)
+        np.testing.assert_array_equal(batches[1][1][1, 0].numpy(), expected)
+
+
+class CommandLine(unittest.TestCase):
+    def test_contact_sheet_is_written(self):
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, 'sheet.png')
+            self.assertEqual(scenes.main(['--contact-sheet', path, '--seeds', '1', '2']), 0)
+            self.assertGreater(os.path.getsize(path), 1000)
+
+    def test_failure_is_one_line_and_non_zero(self):
+        with tempfile.TemporaryDirectory() as folder:
+            path = os.path.join(folder, 'missing', 'sheet.png')
+            self.assertEqual(scenes.main(['--contact-sheet', path, '--seeds', '1']), 1)
+
+
+if __name__ == '__main__':
+    unittest.main(verbosity=2)
