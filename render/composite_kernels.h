@@ -1,0 +1,74 @@
+// Micro-kernels of the MPI compositor: warp one premultiplied layer along a row of the
+// new view and composite it over the row's accumulator; convert an accumulator row to
+// 8-bit BGR. Pure functions (single-threaded, no allocation); the renderer splits the
+// frame into tiles and calls them per tile row. Each instruction set has its own
+// variant beside the scalar reference; all compute the same formulas in the same order,
+// so they differ only by rounding (FMA contraction).
+#pragma once
+#include <cstdint>
+
+#include "engine/isa.h"
+
+namespace ampi::render {
+
+// A premultiplied layer as the kernels read it: BGRA half floats in [0, 1], with a zero
+// border of one pixel on the left and top and two on the right and bottom, so a bilinear
+// footprint whose coordinates are clamped to [-1, width] x [-1, height] is always inside
+// the buffer and reads transparent pixels outside the layer (no edge branches).
+struct PlaneView {
+  const uint16_t* origin = nullptr;  // layer pixel (0, 0): 4 halves per pixel
+  int64_t stride = 0;                // pixels between rows of the padded buffer
+  int width = 0, height = 0;         // the layer's size (without the border)
+};
+
+// Row-major 3x3 map from new-view pixels to layer pixels (the inverse plane homography),
+// pixel centres at integer coordinates.
+struct InverseHomography {
+  float m[9];
+};
+
+// Points whose homogeneous w is at most this lie behind the new camera: transparent.
+constexpr float kMinHomogeneousW = 1e-6f;
+
+// For x in [x_begin, x_begin + count) of output row y: samples the layer at
+// H^-1 (x, y, 1) with bilinear interpolation and composites it over accum (4 floats per
+// pixel, BGRA premultiplied): accum = sample + accum * (1 - sample.alpha).
+using WarpOverRowFn = void (*)(const PlaneView& plane, const InverseHomography& h, int y,
+                               int x_begin, int count, float* accum);
+// bgr[3i..3i+2] = round(255 * accum[4i..4i+2]) clamped to [0, 255], for i in [0, count):
+// the composite over a black background.
+using AccumToBgrFn = void (*)(const float* accum, int count, uint8_t* bgr);
+
+struct CompositeKernels {
+  Isa isa = Isa::Scalar;
+  WarpOverRowFn warp_over_row = nullptr;
+  AccumToBgrFn accum_to_bgr = nullptr;
+};
+
+// The variant for an instruction set (AVX-512 runs the AVX2 variant); throws
+// std::runtime_error if this build or CPU cannot run it.
+CompositeKernels composite_kernels(Isa isa);
+
+namespace scalar {
+void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
+                   int count, float* accum);
+void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
+}  // namespace scalar
+
+#if defined(__x86_64__)
+namespace avx2 {
+void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
+                   int count, float* accum);
+void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
+}  // namespace avx2
+#endif
+
+#if defined(__aarch64__)
+namespace neon {
+void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
+                   int count, float* accum);
+void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
+}  // namespace neon
+#endif
+
+}  // namespace ampi::render
