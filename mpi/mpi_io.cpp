@@ -79,14 +79,22 @@ std::string description_json(const Mpi& mpi, const std::vector<std::string>& lay
 
 // ---- reading ---------------------------------------------------------------------------
 
+// OpenCV's JSON parser reports a syntax error as "PATH(LINE): REASON" in the exception's
+// function field; other failures (empty file, no top-level object) carry nothing useful.
+std::string json_error(const cv::Exception& e) {
+  const size_t close = e.func.rfind("): ");
+  const size_t open = close == std::string::npos ? close : e.func.rfind('(', close);
+  if (e.code != cv::Error::StsParseError || open == std::string::npos) return "malformed JSON";
+  return "malformed JSON at line " + e.func.substr(open + 1, close - open - 1) + " (" + e.func.substr(close + 3) + ")";
+}
+
 cv::FileStorage open_json(const std::string& path) {
   try {
     cv::FileStorage in(path, cv::FileStorage::READ | cv::FileStorage::FORMAT_JSON);
     if (!in.isOpened()) fail(path, "cannot be opened");
-    if (!in.root().isMap()) fail(path, "malformed JSON (the top level is not an object)");
     return in;
   } catch (const cv::Exception& e) {
-    fail(path, "malformed JSON (" + e.err + ")");
+    fail(path, json_error(e));
   }
 }
 

@@ -3,7 +3,9 @@
 #include <sys/stat.h>
 
 #include <algorithm>
+#include <cctype>
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -12,6 +14,7 @@
 #include <vector>
 
 #include "mpi/mpi_io.h"
+#include "weights_format/npy.h"
 
 namespace ampi {
 namespace {
@@ -32,8 +35,17 @@ std::vector<unsigned char> read_file_bytes(const std::string& path) {
   return bytes;
 }
 
+// libpng reports a cut-off file on stderr before failing; catch it first so the user
+// sees one line. A PNG ends with its IEND chunk (length, "IEND", CRC).
+void check_png_complete(const std::string& path, const std::vector<unsigned char>& b) {
+  static const unsigned char kSignature[8] = {0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n'};
+  if (b.size() < 8 || std::memcmp(b.data(), kSignature, 8) != 0) return;
+  if (b.size() < 20 || std::memcmp(&b[b.size() - 8], "IEND", 4) != 0) fail(path, "truncated PNG (no IEND chunk)");
+}
+
 cv::Mat decode_image(const std::string& path) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
+  check_png_complete(path, bytes);
   cv::Mat image;
   try {
     image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
@@ -47,6 +59,28 @@ cv::Mat decode_image(const std::string& path) {
     cv::extractChannel(image, image, 0);
   }
   return image;
+}
+
+bool has_npy_extension(const std::string& path) {
+  if (path.size() < 4) return false;
+  std::string ext = path.substr(path.size() - 4);
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext == ".npy";
+}
+
+// An array of shape H x W once its size-1 axes are dropped ((1, H, W), (H, W, 1), ...).
+cv::Mat read_npy_map(const std::string& path) {
+  const Tensor t = read_npy(path);
+  std::vector<int64_t> dims;
+  for (int64_t d : t.shape())
+    if (d != 1) dims.push_back(d);
+  if (t.numel() == 0) fail(path, "empty array");
+  while (t.rank() >= 2 && dims.size() < 2) dims.insert(dims.begin(), 1);  // 1 x 1 or 1 x N maps
+  if (dims.size() != 2 || dims[0] > INT_MAX || dims[1] > INT_MAX)
+    fail(path, "array of shape " + shape_str(t.shape()) + " is not a depth map (expected H x W)");
+  cv::Mat map(static_cast<int>(dims[0]), static_cast<int>(dims[1]), CV_32FC1);
+  std::memcpy(map.data, t.f32(), static_cast<size_t>(t.numel()) * sizeof(float));
+  return map;
 }
 
 // 1/x for positive distances; zero or negative ones take the smallest disparity found.
@@ -65,9 +99,11 @@ void invert_distances(cv::Mat& map, const std::string& path) {
 }  // namespace
 
 cv::Mat read_depth_map(const std::string& path, bool is_distance) {
-  const cv::Mat raw = decode_image(path);
   cv::Mat map;
-  raw.convertTo(map, CV_32F);
+  if (has_npy_extension(path))
+    map = read_npy_map(path);
+  else
+    decode_image(path).convertTo(map, CV_32F);
   if (!cv::checkRange(map, true)) fail(path, "contains NaN or infinite values");
   if (is_distance) invert_distances(map, path);
   return map;

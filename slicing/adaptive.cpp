@@ -57,12 +57,15 @@ cv::Mat normalize_disparity_float(const cv::Mat& disparity) {
   check_disparity(disparity);
   double lo = 0, hi = 0;
   cv::minMaxLoc(disparity, &lo, &hi);
-  cv::Mat out;
-  if (hi > lo) {
-    const double scale = (kDisparityLevels - 1) / (hi - lo);
-    disparity.convertTo(out, CV_32F, scale, -lo * scale);
-  } else {
-    out = cv::Mat::zeros(disparity.size(), CV_32FC1);
+  cv::Mat out = cv::Mat::zeros(disparity.size(), CV_32FC1);
+  if (!(hi > lo)) return out;
+  // Offset first, then scale and clamp: the extremes land exactly on 0 and 255. Double
+  // precision keeps the difference of any two finite floats finite.
+  const double top = kDisparityLevels - 1, scale = top / (hi - lo);
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* in = disparity.ptr<float>(y);
+    float* v = out.ptr<float>(y);
+    for (int x = 0; x < disparity.cols; ++x) v[x] = static_cast<float>(std::min((in[x] - lo) * scale, top));
   }
   return out;
 }
