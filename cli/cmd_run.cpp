@@ -1,0 +1,165 @@
+// ampi run PHOTO... -o DIR: one command from photo to 3D photo.
+#include <algorithm>
+#include <cctype>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cli/args.h"
+#include "cli/commands.h"
+#include "engine/thread_pool.h"
+#include "mpi/mpi_io.h"
+#include "pipeline/depth_io.h"
+#include "pipeline/make_mpi.h"
+#include "pipeline/output_staging.h"
+#include "pipeline/photo_io.h"
+
+namespace fs = std::filesystem;
+
+namespace ampi::cli {
+namespace {
+
+const char kUsage[] =
+    "usage: ampi run PHOTO... -o DIR [options]\n"
+    "\n"
+    "Turns each photo into an adaptive multiplane image and its outputs:\n"
+    "  DIR/depth.png   16-bit disparity (larger = nearer) at the photo's size\n"
+    "  DIR/mpi/        layer_XX.png (RGBA, back to front) and mpi.json\n"
+    "Several photos, or a folder of photos: one sub-folder of DIR each, named after the\n"
+    "photo. A photo that fails is reported and skipped; the exit code is then 1.\n"
+    "\n"
+    "  -o, --output DIR        where to write (refused if it exists, unless --force)\n"
+    "  --force                 replace ampi's own outputs in an existing DIR (nothing else\n"
+    "                          in it is touched)\n"
+    "  --model lite|heavy      bundled depth network (default lite)\n"
+    "  --weights FILE          depth network weight file instead of the bundled one\n"
+    "  --depth FILE            your own depth map instead of the network (one photo only):\n"
+    "                          8/16-bit PNG, float TIFF or .npy, the photo's size\n"
+    "  --depth-is-distance     the --depth map holds distances (larger = farther)\n"
+    "  --working-size N        long side the depth network and slicer run at (default 1024;\n"
+    "                          layers are always cut at the photo's full resolution)\n"
+    "  --max-planes N          at most N planes (default 8)\n"
+    "  --uniform               equal disparity intervals (the paper's baseline)\n"
+    "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
+    "  --inpaint-weights FILE  inpainting network weight file instead of the bundled one\n"
+    "  --fov DEG               assumed horizontal field of view (default 60)\n"
+    "  --threads N             worker threads (default: all cores)\n"
+    "  --quiet                 no progress on stderr\n";
+
+struct RunArgs {
+  std::vector<std::string> inputs;
+  std::string output;
+  bool force = false;
+  bool quiet = false;
+  int threads = 0;
+  MpiOptions mpi;
+};
+
+RunArgs parse(int argc, char** argv, bool& help) {
+  RunArgs a;
+  ArgParser p("run", kUsage);
+  p.positionals(&a.inputs);
+  p.option("-o", &a.output);
+  p.option("--output", &a.output);
+  p.flag("--force", &a.force);
+  p.flag("--quiet", &a.quiet);
+  p.option("--threads", &a.threads, 1, 256);
+  p.option("--model", [&](const std::string& v) {
+    if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
+    a.mpi.depth_model = v;
+  });
+  p.option("--weights", &a.mpi.depth_weights);
+  p.option("--depth", &a.mpi.depth_file);
+  p.flag("--depth-is-distance", &a.mpi.depth_is_distance);
+  p.option("--working-size", &a.mpi.working_size, kMinPhotoSide, 16384);
+  p.option("--max-planes", &a.mpi.slicing.max_planes, 1, kDisparityLevels - 1);
+  p.flag("--uniform", &a.mpi.uniform);
+  p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
+  p.option("--inpaint-weights", &a.mpi.inpaint_weights);
+  p.option("--fov", &a.mpi.fov_degrees, 1, 179);
+  help = !p.parse(argc, argv);
+  if (help) return a;
+  if (a.inputs.empty()) throw std::runtime_error("missing PHOTO (see ampi run --help)");
+  if (a.output.empty()) throw std::runtime_error("missing -o DIR (see ampi run --help)");
+  return a;
+}
+
+bool is_photo_name(const fs::path& p) {
+  static const std::set<std::string> kExtensions = {".jpg", ".jpeg", ".png", ".tif", ".tiff",
+                                                    ".bmp", ".webp", ".jp2", ".ppm", ".pgm"};
+  std::string ext = p.extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return kExtensions.count(ext) > 0;
+}
+
+// The photos named on the command line; a folder stands for the photos in it (sorted).
+// A path that does not exist stays in the list, so its error is reported in turn.
+std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
+  std::vector<std::string> photos;
+  for (const std::string& input : inputs) {
+    std::error_code ec;
+    if (!fs::is_directory(input, ec)) {
+      photos.push_back(input);
+      continue;
+    }
+    std::vector<std::string> found;
+    for (const auto& entry : fs::directory_iterator(input))
+      if (entry.is_regular_file() && is_photo_name(entry.path())) found.push_back(entry.path().string());
+    if (found.empty()) throw std::runtime_error(input + ": folder holds no photos");
+    std::sort(found.begin(), found.end());
+    photos.insert(photos.end(), found.begin(), found.end());
+  }
+  return photos;
+}
+
+void run_one(MpiMaker& maker, const std::string& photo, const std::string& destination, bool force,
+             Progress& progress) {
+  OutputStaging staging(destination, force);
+  const cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo); });
+  const MpiResult result = maker.make(bgr, photo, progress);
+  progress.stage("write mpi", [&] {
+    const fs::path dir(staging.dir());
+    write_depth_png16(result.disparity, (dir / "depth.png").string());
+    write_mpi(result.mpi, (dir / "mpi").string());
+  });
+  staging.commit();
+  progress.note(photo + ": " + std::to_string(result.mpi.planes.size()) + " planes, inpainted by " +
+                result.inpainter + " -> " + destination);
+}
+
+}  // namespace
+
+int cmd_run(int argc, char** argv) {
+  bool help = false;
+  const RunArgs a = parse(argc, argv, help);
+  if (help) return 0;
+  if (a.threads > 0) set_default_threads(a.threads);
+  const std::vector<std::string> photos = expand_inputs(a.inputs);
+  const bool one = photos.size() == 1 && !fs::is_directory(a.inputs.front());
+  if (!a.mpi.depth_file.empty() && !one)
+    throw std::runtime_error("--depth: a depth map belongs to one photo, but " +
+                             std::to_string(photos.size()) + " were given");
+  if (!one) fs::create_directories(a.output);
+
+  MpiMaker maker(a.mpi);
+  Progress progress(a.quiet);
+  int failed = 0;
+  for (const std::string& photo : photos) {
+    const std::string destination = one ? a.output : (fs::path(a.output) / fs::path(photo).stem()).string();
+    if (!one) progress.note(photo);
+    try {
+      run_one(maker, photo, destination, a.force, progress);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "ampi run: %s\n", e.what());
+      ++failed;
+    }
+  }
+  if (failed && photos.size() > 1)
+    std::fprintf(stderr, "ampi run: %d of %zu photos failed\n", failed, photos.size());
+  return failed ? 1 : 0;
+}
+
+}  // namespace ampi::cli

@@ -1,0 +1,22 @@
+#include "pipeline/depth_estimate.h"
+
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+namespace ampi {
+
+cv::Mat estimate_disparity(DepthNet& net, const cv::Mat& bgr, int max_side, ThreadPool& pool) {
+  if (bgr.type() != CV_8UC3 || bgr.empty())
+    throw std::invalid_argument("estimate_disparity: expects a non-empty 8-bit BGR image");
+  const ImageSize work = depth_working_size(bgr.rows, bgr.cols, max_side);
+  cv::Mat small = bgr;
+  if (work.width != bgr.cols || work.height != bgr.rows)
+    cv::resize(bgr, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+  cv::Mat rgb;
+  cv::cvtColor(small, rgb, cv::COLOR_BGR2RGB);
+  rgb.convertTo(rgb, CV_32FC3, 1.0 / 255.0);  // contiguous [h][w][3] in [0, 1]
+  const Tensor disparity = net.run(rgb.ptr<float>(), rgb.rows, rgb.cols, pool);
+  return cv::Mat(rgb.rows, rgb.cols, CV_32FC1, const_cast<float*>(disparity.f32())).clone();
+}
+
+}  // namespace ampi

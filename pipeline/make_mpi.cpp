@@ -1,0 +1,110 @@
+#include "pipeline/make_mpi.h"
+
+#include <cmath>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+
+#include "inpaint/inpaint_net.h"
+#include "nets/weights_path.h"
+#include "pipeline/depth_estimate.h"
+#include "pipeline/depth_io.h"
+#include "pipeline/photo_io.h"
+#include "slicing/assemble.h"
+
+namespace ampi {
+
+namespace {
+
+// The bundled inpainting weights, or "" when this installation has none.
+std::string bundled_inpaint_weights() {
+  try {
+    return find_weights("inpaint.ampw");
+  } catch (const std::runtime_error&) {
+    return "";
+  }
+}
+
+// The margin to fill scales with the photo: the paper's 40 px are at about 1024 px.
+OcclusionMaskParams margin_for(const cv::Size& size) {
+  OcclusionMaskParams params;
+  const double scale = std::max(size.width, size.height) / 1024.0;
+  params.dilate_iterations = std::max(1, static_cast<int>(std::lround(40 * std::max(scale, 0.25))));
+  return params;
+}
+
+}  // namespace
+
+MpiMaker::MpiMaker(MpiOptions options) : options_(std::move(options)) {
+  if (options_.working_size < kMinPhotoSide)
+    throw std::invalid_argument("working size must be at least " + std::to_string(kMinPhotoSide) + " px");
+}
+
+MpiMaker::~MpiMaker() = default;
+
+cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, const std::string& photo_path,
+                                    Progress& progress) {
+  if (!options_.depth_file.empty()) {
+    cv::Mat disparity = progress.stage("depth (file)", [&] {
+      return read_depth_map(options_.depth_file, options_.depth_is_distance);
+    });
+    if (disparity.size() != bgr.size())
+      throw std::runtime_error(options_.depth_file + ": depth map is " + std::to_string(disparity.cols) +
+                               "x" + std::to_string(disparity.rows) + " but the photo " + photo_path +
+                               " is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows));
+    return disparity;
+  }
+  if (!depth_net_) {
+    const std::string path = options_.depth_weights.empty()
+                                 ? find_weights("depth_" + options_.depth_model + ".ampw")
+                                 : options_.depth_weights;
+    depth_net_.emplace(progress.stage("load depth", [&] { return DepthNet::load(path); }));
+  }
+  return progress.stage("depth", [&] {
+    return estimate_disparity(*depth_net_, bgr, options_.working_size);
+  });
+}
+
+LayerFiller& MpiMaker::filler() {
+  if (filler_) return *filler_;
+  const std::string path =
+      options_.inpaint_weights.empty() ? bundled_inpaint_weights() : options_.inpaint_weights;
+  if (path.empty()) {
+    filler_ = push_pull_filler();
+    inpainter_ = "push-pull";
+  } else {
+    filler_ = inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(path)));
+    inpainter_ = "network";
+  }
+  return *filler_;
+}
+
+MpiResult MpiMaker::make(const cv::Mat& bgr, const std::string& photo_path, Progress& progress) {
+  MpiResult result;
+  const cv::Mat disparity = working_disparity(bgr, photo_path, progress);
+  // Slice at the working resolution (the histogram needs no more pixels), cut the
+  // layers at the photo's own resolution.
+  std::vector<Plane> planes = progress.stage("slicing", [&] {
+    cv::Mat small = disparity;
+    const ImageSize work = depth_working_size(disparity.rows, disparity.cols, options_.working_size);
+    if (work.width != disparity.cols || work.height != disparity.rows)
+      cv::resize(disparity, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+    return options_.uniform
+               ? slice_uniform(small, options_.slicing.max_planes, options_.slicing.range)
+               : slice_adaptive(small, options_.slicing);
+  });
+  result.mpi = progress.stage("assembly", [&] {
+    if (disparity.size() == bgr.size())
+      result.disparity = disparity;
+    else
+      cv::resize(disparity, result.disparity, bgr.size(), 0, 0, cv::INTER_LINEAR);
+    const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
+    return assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range,
+                        options_.soft_alpha);
+  });
+  LayerFiller& fill = filler();
+  progress.stage("inpainting", [&] { return inpaint_mpi(result.mpi, fill, margin_for(bgr.size())); });
+  result.inpainter = inpainter_;
+  return result;
+}
+
+}  // namespace ampi

@@ -1,0 +1,56 @@
+// Photo to adaptive MPI: depth, slicing, assembly at the photo's full resolution, and
+// inpainting of the occluded margins. The stages of `ampi run` before any output is
+// written; `ampi bench pipeline` times the same calls.
+#pragma once
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "inpaint/mpi_inpaint.h"
+#include "mpi/mpi.h"
+#include "nets/depth_net.h"
+#include "pipeline/progress.h"
+#include "slicing/adaptive.h"
+
+namespace ampi {
+
+struct MpiOptions {
+  std::string depth_model = "lite";  // bundled weights/depth_<model>.ampw
+  std::string depth_weights;         // a weight file instead of the bundled one
+  std::string depth_file;            // the user's own depth map instead of the network
+  bool depth_is_distance = false;    // depth_file holds distances (larger = farther)
+  int working_size = 1024;           // long side the network and the slicer run at
+  bool uniform = false;              // the paper's baseline instead of adaptive slicing
+  SlicingParams slicing;             // max_planes, the paper's constants, depth range
+  double soft_alpha = 0;             // alpha ramp across plane cuts (0 = the paper)
+  std::string inpaint_weights;       // a weight file instead of the bundled one
+  double fov_degrees = 60;           // assumed horizontal field of view of the photo
+};
+
+struct MpiResult {
+  cv::Mat disparity;  // CV_32FC1 at the photo's size, larger = nearer
+  Mpi mpi;            // inpainted
+  std::string inpainter;  // which filler ran: "network" or "push-pull"
+};
+
+// Holds what is loaded once and reused across photos (the networks).
+class MpiMaker {
+ public:
+  explicit MpiMaker(MpiOptions options);
+  ~MpiMaker();
+  const MpiOptions& options() const { return options_; }
+
+  // bgr: the decoded photo (pipeline/photo_io.h). `photo_path` names it in errors.
+  MpiResult make(const cv::Mat& bgr, const std::string& photo_path, Progress& progress);
+
+ private:
+  cv::Mat working_disparity(const cv::Mat& bgr, const std::string& photo_path, Progress& progress);
+  LayerFiller& filler();
+
+  MpiOptions options_;
+  std::optional<DepthNet> depth_net_;
+  std::optional<LayerFiller> filler_;
+  std::string inpainter_;
+};
+
+}  // namespace ampi
