@@ -7,8 +7,8 @@
 
 namespace ampi {
 
-// Table-driven, eight bytes per step ("slicing-by-8"): several GB/s, so checking every
-// tensor at load time costs little next to reading the file.
+// Table-driven, sixteen bytes per step ("slicing-by-16"): over 1 GB/s even on a busy
+// machine, so checking every tensor at load time costs little next to reading the file.
 uint32_t crc32(const void* data, size_t size);
 
 // Bit-at-a-time definition of the same function: the reference the fast one is tested

@@ -174,7 +174,10 @@ MetaValue read_meta_value(HeaderCursor& cur, uint8_t type_code, const std::strin
         return ints;
       }
       std::vector<double> floats(count);
-      std::memcpy(floats.data(), p, count * 8);
+      for (uint64_t i = 0; i < count; ++i) {
+        const uint64_t bits = load_le(p + 8 * i, 8);
+        std::memcpy(&floats[i], &bits, 8);
+      }
       return floats;
     }
   }
