@@ -142,7 +142,8 @@ std::vector<int> plane_boundaries(const std::vector<int>& selected,
   b.erase(std::unique(b.begin(), b.end()), b.end());
   auto count = [&](size_t j) {
     long long c = 0;
-    for (int level = b[j]; level < interval_end(b[j + 1]); ++level) c += bin_counts[level];
+    const int end = b[j + 1] == n - 1 ? n : b[j + 1];  // the top interval holds the last bin
+    for (int level = b[j]; level < end; ++level) c += bin_counts[level];
     return c;
   };
   for (size_t j = 0; j + 1 < b.size() && b.size() > 2;) {
