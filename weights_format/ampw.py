@@ -330,11 +330,12 @@ def decode_ampw(data, origin="<bytes>"):
         if key in metadata:
             fail("duplicate metadata key '%s'" % key)
         metadata[key] = value
-    entries = []
+    entries, names = [], set()
     for i in range(n_tensors):
         entry = _read_tensor_entry(cur, i, data_bytes, fail)
-        if any(e[0] == entry[0] for e in entries):
+        if entry[0] in names:
             fail("duplicate tensor name '%s'" % entry[0])
+        names.add(entry[0])
         entries.append(entry)
     if cur.pos != header_bytes and minor <= VERSION_MINOR:
         fail("header has %d unread bytes after the tensor table" % (header_bytes - cur.pos))
