@@ -274,7 +274,46 @@ def folded_parameter_count(model: nn.Module) -> int:
     return total
 
 
+def layer_table(name: str) -> str:
+    """The markdown layer table of nets/ARCHITECTURE.md for one architecture."""
+    net = build(name)
+    rows = ["| stage | resolution | block | kind | in | expanded | out | kernel | SE | act | residual | parameters |",
+            "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+
+    def add(stage, level, specs, modules, in_c):
+        for i, (spec, module) in enumerate(zip(specs, modules)):
+            kind, out_c, exp_c, k, se, act = spec
+            mb = kind == MB
+            rows.append(f"| {stage} | 1/{2 ** level} | {i} | {'MobileNetV3' if mb else 'conv+BN'} | {in_c} | "
+                        f"{exp_c if mb else '-'} | {out_c} | {k}x{k}{' dw' if mb else ''} | "
+                        f"{se_reduced_channels(exp_c) if mb and se else '-'} | {act} | "
+                        f"{'yes' if mb and in_c == out_c else 'no'} | {parameter_count(module)} |")
+            in_c = out_c
+        return in_c
+
+    in_c, enc_c = 3, []
+    for level, (specs, stage) in enumerate(zip(net.arch["encoder"], net.enc), start=1):
+        rows.append(f"| DWT | 1/{2 ** level} | | Haar | {in_c} | | {4 * in_c} | 2x2 s2 | | | | 0 |")
+        in_c = add(f"enc{level}", level, specs, stage, 4 * in_c)
+        enc_c.append(in_c)
+    below = in_c
+    for level in reversed(range(1, len(net.dec) + 1)):
+        rows.append(f"| IDWT + concat | 1/{2 ** level} | | Haar | {below} + skip {enc_c[level - 1]} | | "
+                    f"{below // 4 + enc_c[level - 1]} | | | | | 0 |")
+        below = add(f"dec{level}", level, net.arch["decoder"][level - 1], net.dec[level - 1],
+                    below // 4 + enc_c[level - 1])
+        if level <= NUM_OUTPUTS:
+            k = net.arch["head_kernel"]
+            rows.append(f"| head{level} + IDWT | 1/{2 ** (level - 1)} | | conv+bias, Haar | {below} | | 4 -> 1 | "
+                        f"{k}x{k} | | none | | {parameter_count(net.heads[level - 1])} |")
+    return "\n".join(rows)
+
+
 if __name__ == "__main__":
+    import sys
+    if "--table" in sys.argv:
+        for name in ARCHITECTURES:
+            print(f"### {name}\n\n{layer_table(name)}\n")
     for name in ARCHITECTURES:
         net = build(name)
         trained = parameter_count(net)

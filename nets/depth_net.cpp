@@ -1,0 +1,382 @@
+#include "nets/depth_net.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <stdexcept>
+
+#include "engine/arena.h"
+#include "kernels/conv.h"
+#include "kernels/ops.h"
+#include "weights_format/weight_file.h"
+
+namespace ampi {
+namespace {
+
+constexpr const char* kArchName = "ampi.depth.dwt-mobilenetv3";
+constexpr int64_t kFormatVersion = 1;
+constexpr int kFieldsPerBlock = 6;  // kind, out, expanded, kernel, se_reduced, activation
+constexpr int kMaxLevels = 8;
+
+enum class BlockKind { Conv = 0, MobileNetV3 = 1 };
+
+struct BlockSpec {
+  BlockKind kind;
+  int out_c, expanded, kernel, se_reduced;
+  Activation act;
+};
+
+// One block with its weights packed. A plain block uses `conv` only; a MobileNetV3 block
+// uses expand (absent when expanded == in_c), dw, se (when se_reduced > 0) and project.
+struct Block {
+  BlockSpec spec;
+  int in_c = 0;
+  Conv2d conv, expand, dw, project;
+  bool has_expand = false, has_se = false, residual = false;
+  SqueezeExcite se;
+};
+
+using Stage = std::vector<Block>;
+
+[[noreturn]] void fail(const WeightFile& f, const std::string& problem) {
+  throw std::runtime_error(f.path() + ": " + problem);
+}
+
+Activation activation_from_code(const WeightFile& f, const std::string& where, int64_t code) {
+  switch (code) {
+    case 0: return Activation::None;
+    case 1: return Activation::ReLU;
+    case 2: return Activation::HardSwish;
+  }
+  fail(f, where + ": unknown activation code " + std::to_string(code));
+}
+
+std::vector<BlockSpec> parse_stage(const WeightFile& f, const std::string& key) {
+  const std::vector<int64_t> v = f.get_ints(key);
+  if (v.empty() || v.size() % kFieldsPerBlock)
+    fail(f, key + ": " + std::to_string(v.size()) + " values, not a non-empty multiple of " +
+                std::to_string(kFieldsPerBlock));
+  std::vector<BlockSpec> specs;
+  for (size_t i = 0; i < v.size(); i += kFieldsPerBlock) {
+    const std::string where = key + " block " + std::to_string(i / kFieldsPerBlock);
+    if (v[i] != 0 && v[i] != 1) fail(f, where + ": unknown block kind " + std::to_string(v[i]));
+    const auto kind = static_cast<BlockKind>(v[i]);
+    const int64_t out_c = v[i + 1], expanded = v[i + 2], kernel = v[i + 3], reduced = v[i + 4];
+    if (out_c <= 0 || out_c > 65536) fail(f, where + ": bad output channel count " + std::to_string(out_c));
+    if (kernel <= 0 || kernel % 2 == 0 || kernel > 15) fail(f, where + ": kernel " + std::to_string(kernel) + " is not odd in 1..15");
+    if (kind == BlockKind::MobileNetV3 && (expanded <= 0 || expanded > 65536))
+      fail(f, where + ": bad expanded channel count " + std::to_string(expanded));
+    if (reduced < 0 || reduced > 65536 || (reduced > 0 && kind != BlockKind::MobileNetV3))
+      fail(f, where + ": bad squeeze-excite width " + std::to_string(reduced));
+    specs.push_back({kind, int(out_c), int(expanded), int(kernel), int(reduced),
+                     activation_from_code(f, where, v[i + 5])});
+  }
+  return specs;
+}
+
+// A stride-1 convolution with 'same' padding, weights checked by name and packed.
+Conv2d load_conv(const WeightFile& f, const std::string& name, int in_c, int out_c, int kernel,
+                 int groups, Activation act, const KernelTable& table, int64_t& params) {
+  const Tensor w = f.tensor(name + ".weight", {out_c, kernel, kernel, in_c / groups});
+  const Tensor b = f.tensor(name + ".bias", {out_c});
+  params += w.numel() + b.numel();
+  ConvParams p;
+  p.in_c = in_c;
+  p.out_c = out_c;
+  p.kernel_h = p.kernel_w = kernel;
+  p.pad_top = p.pad_left = p.pad_bottom = p.pad_right = kernel / 2;
+  p.groups = groups;
+  p.act = {act};
+  return Conv2d(p, w.f32(), b.f32(), table);
+}
+
+Block load_block(const WeightFile& f, const std::string& prefix, const BlockSpec& s, int in_c,
+                 const KernelTable& table, int64_t& params) {
+  Block b;
+  b.spec = s;
+  b.in_c = in_c;
+  if (s.kind == BlockKind::Conv) {
+    b.conv = load_conv(f, prefix + ".conv", in_c, s.out_c, s.kernel, 1, s.act, table, params);
+    return b;
+  }
+  b.has_expand = s.expanded != in_c;
+  if (b.has_expand)
+    b.expand = load_conv(f, prefix + ".expand", in_c, s.expanded, 1, 1, s.act, table, params);
+  b.dw = load_conv(f, prefix + ".dw", s.expanded, s.expanded, s.kernel, s.expanded, s.act, table, params);
+  b.has_se = s.se_reduced > 0;
+  if (b.has_se) {
+    const Tensor w1 = f.tensor(prefix + ".se.fc1.weight", {s.se_reduced, s.expanded});
+    const Tensor b1 = f.tensor(prefix + ".se.fc1.bias", {s.se_reduced});
+    const Tensor w2 = f.tensor(prefix + ".se.fc2.weight", {s.expanded, s.se_reduced});
+    const Tensor b2 = f.tensor(prefix + ".se.fc2.bias", {s.expanded});
+    params += w1.numel() + b1.numel() + w2.numel() + b2.numel();
+    b.se = SqueezeExcite(s.expanded, s.se_reduced, w1.f32(), b1.f32(), w2.f32(), b2.f32(), table);
+  }
+  b.project = load_conv(f, prefix + ".project", s.expanded, s.out_c, 1, 1, Activation::None, table, params);
+  b.residual = in_c == s.out_c;
+  return b;
+}
+
+Stage load_stage(const WeightFile& f, const std::string& key, const std::string& prefix, int in_c,
+                 const KernelTable& table, int64_t& params) {
+  Stage stage;
+  for (const BlockSpec& s : parse_stage(f, key)) {
+    stage.push_back(load_block(f, prefix + "." + std::to_string(stage.size()), s, in_c, table, params));
+    in_c = s.out_c;
+  }
+  return stage;
+}
+
+int out_channels(const Stage& s) { return s.back().spec.out_c; }
+
+// ---- execution plan -----------------------------------------------------------------------
+
+// The network unrolled for one padded input size: a list of steps, each reading and
+// writing activation values that live in one arena. A value's lifetime runs from the step
+// that writes it to the last step that reads it; the arena lets values whose lifetimes do
+// not overlap share bytes, and never places a step's output over one of its inputs.
+class Plan {
+ public:
+  struct Value {
+    int h, w, c;
+    int first, last;
+    int arena_id = -1;
+  };
+  using Step = std::function<void(Plan&, ThreadPool&)>;
+
+  // Declares the value the next pushed step writes.
+  int produce(int h, int w, int c) {
+    const int now = static_cast<int>(steps_.size());
+    values_.push_back({h, w, c, now, now});
+    return static_cast<int>(values_.size()) - 1;
+  }
+  // Marks `v` as read by the next pushed step.
+  void consume(int v) { values_.at(v).last = std::max(values_[v].last, int(steps_.size())); }
+  void push(Step step) { steps_.push_back(std::move(step)); }
+  const Value& value(int v) const { return values_.at(v); }
+
+  void allocate() {
+    for (Value& v : values_)
+      v.arena_id = arena_.request(size_t(v.h) * v.w * v.c * sizeof(float), v.first, v.last);
+    arena_.plan();
+  }
+  float* data(int v) { return static_cast<float*>(arena_.data(values_[v].arena_id)); }
+  void execute(ThreadPool& pool) {
+    for (Step& s : steps_) s(*this, pool);
+  }
+  size_t arena_bytes() const { return arena_.total_bytes(); }
+
+  // What the first step reads: the caller's image, set before every execute().
+  const float* rgb = nullptr;
+  int rgb_h = 0, rgb_w = 0;
+  int output = -1;  // the value holding the padded full-resolution disparity
+
+ private:
+  std::vector<Value> values_;
+  std::vector<Step> steps_;
+  Arena arena_;
+};
+
+}  // namespace
+
+ImageSize depth_working_size(int height, int width, int max_side) {
+  if (height <= 0 || width <= 0 || max_side <= 0)
+    throw std::invalid_argument("depth_working_size: sizes must be positive");
+  const int long_side = std::max(height, width);
+  if (long_side <= max_side) return {height, width};
+  const double scale = double(max_side) / long_side;
+  return {std::max(1, int(std::lround(height * scale))), std::max(1, int(std::lround(width * scale)))};
+}
+
+struct DepthNet::Impl {
+  std::string variant;
+  int levels = 0;
+  float mean[3], inv_std[3];
+  std::vector<Stage> encoder, decoder;  // decoder[l] works at level l + 1
+  Conv2d head;                          // on decoder level 1: the Haar coefficients of the output
+  int64_t params = 0;
+  const KernelTable* table = nullptr;
+  std::unique_ptr<Plan> plan;
+  int plan_h = 0, plan_w = 0;
+
+  int multiple() const { return 1 << levels; }
+  std::unique_ptr<Plan> build_plan(int h, int w) const;
+  int add_stage(Plan& p, const Stage& stage, int x, int h, int w) const;
+  int add_block(Plan& p, const Block& b, int x, int h, int w) const;
+};
+
+// Loads and checks everything the metadata promises before any weight is packed.
+DepthNet DepthNet::load(const std::string& path, const KernelTable& table) {
+  const WeightFile f = WeightFile::open(path);
+  if (f.get_string("arch") != kArchName)
+    fail(f, "architecture '" + f.get_string("arch") + "' is not a depth network (" + kArchName + ")");
+  if (f.get_int("depth.format_version") != kFormatVersion)
+    fail(f, "depth.format_version " + std::to_string(f.get_int("depth.format_version")) +
+                " is not supported (this build reads " + std::to_string(kFormatVersion) + ")");
+  auto impl = std::make_unique<Impl>();
+  impl->table = &table;
+  impl->variant = f.get_string("depth.variant");
+  const int64_t levels = f.get_int("depth.levels");
+  if (levels < 2 || levels > kMaxLevels) fail(f, "depth.levels " + std::to_string(levels) + " is not in 2..8");
+  impl->levels = int(levels);
+  if (f.get_int("depth.multiple") != impl->multiple())
+    fail(f, "depth.multiple disagrees with 2^depth.levels");
+  const std::vector<double> mean = f.get_floats("depth.input_mean"), stdev = f.get_floats("depth.input_std");
+  if (mean.size() != 3 || stdev.size() != 3) fail(f, "depth.input_mean and depth.input_std need 3 values");
+  for (int c = 0; c < 3; ++c) {
+    if (!(stdev[c] > 0)) fail(f, "depth.input_std must be positive");
+    impl->mean[c] = float(mean[c]);
+    impl->inv_std[c] = float(1.0 / stdev[c]);
+  }
+
+  std::vector<int> enc_c;
+  int in_c = 3;
+  for (int l = 1; l <= impl->levels; ++l) {
+    const std::string n = std::to_string(l);
+    impl->encoder.push_back(load_stage(f, "depth.encoder." + n, "enc" + n, 4 * in_c, table, impl->params));
+    in_c = out_channels(impl->encoder.back());
+    enc_c.push_back(in_c);
+  }
+  impl->decoder.resize(impl->levels - 1);
+  int below = enc_c.back();
+  for (int l = impl->levels - 1; l >= 1; --l) {
+    if (below % 4) fail(f, "level " + std::to_string(l + 1) + " has " + std::to_string(below) +
+                               " channels, not a multiple of 4 for the inverse DWT");
+    const std::string n = std::to_string(l);
+    impl->decoder[l - 1] = load_stage(f, "depth.decoder." + n, "dec" + n, below / 4 + enc_c[l - 1], table, impl->params);
+    below = out_channels(impl->decoder[l - 1]);
+  }
+  const int64_t head_kernel = f.get_int("depth.head_kernel");
+  if (head_kernel <= 0 || head_kernel % 2 == 0 || head_kernel > 15) fail(f, "depth.head_kernel must be odd in 1..15");
+  impl->head = load_conv(f, "head1", below, 4, int(head_kernel), 1, Activation::None, table, impl->params);
+  return DepthNet(std::move(impl));
+}
+
+int DepthNet::Impl::add_block(Plan& p, const Block& b, int x, int h, int w) const {
+  if (b.spec.kind == BlockKind::Conv) {
+    const int y = p.produce(h, w, b.spec.out_c);
+    p.consume(x);
+    p.push([&b, x, y, h, w](Plan& pl, ThreadPool& pool) { b.conv.run(pl.data(x), h, w, pl.data(y), nullptr, pool); });
+    return y;
+  }
+  int t = x;
+  if (b.has_expand) {
+    const int e = p.produce(h, w, b.spec.expanded);
+    p.consume(t);
+    p.push([&b, t, e, h, w](Plan& pl, ThreadPool& pool) { b.expand.run(pl.data(t), h, w, pl.data(e), nullptr, pool); });
+    t = e;
+  }
+  const int d = p.produce(h, w, b.spec.expanded);
+  p.consume(t);
+  p.push([&b, t, d, h, w](Plan& pl, ThreadPool& pool) { b.dw.run(pl.data(t), h, w, pl.data(d), nullptr, pool); });
+  t = d;
+  if (b.has_se) {  // in place: the gate scales the depthwise output where it lies
+    p.consume(t);
+    p.push([&b, t, h, w](Plan& pl, ThreadPool& pool) { b.se.run(pl.data(t), h, w, pl.data(t), pool); });
+  }
+  const int y = p.produce(h, w, b.spec.out_c);
+  p.consume(t);
+  if (b.residual) p.consume(x);
+  const bool residual = b.residual;
+  p.push([&b, t, x, y, h, w, residual](Plan& pl, ThreadPool& pool) {
+    b.project.run(pl.data(t), h, w, pl.data(y), residual ? pl.data(x) : nullptr, pool);
+  });
+  return y;
+}
+
+int DepthNet::Impl::add_stage(Plan& p, const Stage& stage, int x, int h, int w) const {
+  for (const Block& b : stage) x = add_block(p, b, x, h, w);
+  return x;
+}
+
+std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
+  auto p = std::make_unique<Plan>();
+  const KernelTable& k = *table;
+  // Step 0: normalise the caller's image and replicate its last row and column into the
+  // padding, so the network sees no artificial edge.
+  int x = p->produce(h, w, 3);
+  p->push([this, x, h, w](Plan& pl, ThreadPool& pool) {
+    float* out = pl.data(x);
+    pool.parallel_for(h, 8, [&](int64_t y0, int64_t y1) {
+      for (int64_t y = y0; y < y1; ++y) {
+        const float* row = pl.rgb + size_t(std::min<int64_t>(y, pl.rgb_h - 1)) * pl.rgb_w * 3;
+        for (int xx = 0; xx < w; ++xx) {
+          const float* px = row + size_t(std::min(xx, pl.rgb_w - 1)) * 3;
+          for (int c = 0; c < 3; ++c) out[(size_t(y) * w + xx) * 3 + c] = (px[c] - mean[c]) * inv_std[c];
+        }
+      }
+    });
+  });
+
+  std::vector<int> skips;
+  int c = 3, lh = h, lw = w;
+  for (const Stage& stage : encoder) {
+    const int d = p->produce(lh / 2, lw / 2, 4 * c);
+    p->consume(x);
+    p->push([&k, x, d, lh, lw, c](Plan& pl, ThreadPool& pool) { haar_dwt(pl.data(x), lh, lw, c, pl.data(d), pool, k); });
+    lh /= 2;
+    lw /= 2;
+    x = add_stage(*p, stage, d, lh, lw);
+    c = out_channels(stage);
+    skips.push_back(x);
+  }
+  for (int l = levels - 1; l >= 1; --l) {
+    const int skip = skips[l - 1], skip_c = p->value(skip).c, up_c = c / 4;
+    const int u = p->produce(2 * lh, 2 * lw, up_c);
+    p->consume(x);
+    p->push([&k, x, u, lh, lw, up_c](Plan& pl, ThreadPool& pool) { haar_idwt(pl.data(x), lh, lw, up_c, pl.data(u), pool, k); });
+    lh *= 2;
+    lw *= 2;
+    const int cat = p->produce(lh, lw, up_c + skip_c);
+    p->consume(u);
+    p->consume(skip);
+    const int64_t pixels = int64_t(lh) * lw;
+    p->push([&k, u, skip, cat, up_c, skip_c, pixels](Plan& pl, ThreadPool& pool) {
+      concat_channels(pl.data(u), up_c, pl.data(skip), skip_c, pixels, pl.data(cat), pool, k);
+    });
+    x = add_stage(*p, decoder[l - 1], cat, lh, lw);
+    c = out_channels(decoder[l - 1]);
+  }
+  const int coeffs = p->produce(lh, lw, 4);
+  p->consume(x);
+  p->push([this, x, coeffs, lh, lw](Plan& pl, ThreadPool& pool) { head.run(pl.data(x), lh, lw, pl.data(coeffs), nullptr, pool); });
+  const int out = p->produce(h, w, 1);
+  p->consume(coeffs);
+  p->push([&k, coeffs, out, lh, lw](Plan& pl, ThreadPool& pool) { haar_idwt(pl.data(coeffs), lh, lw, 1, pl.data(out), pool, k); });
+  p->output = out;
+  p->allocate();
+  return p;
+}
+
+Tensor DepthNet::run(const float* rgb, int h, int w, ThreadPool& pool) {
+  if (!rgb || h <= 0 || w <= 0) throw std::invalid_argument("DepthNet::run: empty image");
+  Impl& m = *impl_;
+  const int ph = (h + m.multiple() - 1) / m.multiple() * m.multiple();
+  const int pw = (w + m.multiple() - 1) / m.multiple() * m.multiple();
+  if (!m.plan || m.plan_h != ph || m.plan_w != pw) {
+    m.plan = m.build_plan(ph, pw);
+    m.plan_h = ph;
+    m.plan_w = pw;
+  }
+  Plan& p = *m.plan;
+  p.rgb = rgb;
+  p.rgb_h = h;
+  p.rgb_w = w;
+  p.execute(pool);
+  const float* full = p.data(p.output);  // crop the padding away
+  Tensor out = Tensor::empty({h, w});
+  for (int y = 0; y < h; ++y) std::copy(full + size_t(y) * pw, full + size_t(y) * pw + w, out.f32() + size_t(y) * w);
+  return out;
+}
+
+DepthNet::DepthNet(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
+DepthNet::DepthNet(DepthNet&&) noexcept = default;
+DepthNet& DepthNet::operator=(DepthNet&&) noexcept = default;
+DepthNet::~DepthNet() = default;
+
+const std::string& DepthNet::variant() const { return impl_->variant; }
+int DepthNet::multiple() const { return impl_->multiple(); }
+int64_t DepthNet::parameter_count() const { return impl_->params; }
+size_t DepthNet::arena_bytes() const { return impl_->plan ? impl_->plan->arena_bytes() : 0; }
+
+}  // namespace ampi
