@@ -19,6 +19,7 @@ const Command kCommands[] = {
     {"info", ampi::cli::cmd_info, "print a weight file's metadata and tensor table"},
     {"bench", ampi::cli::cmd_bench, "kernel, network, renderer and pipeline latency"},
     {"slice", ampi::cli::cmd_slice, "cut a depth map into planes (adaptive or uniform), print JSON"},
+    {"depth", ampi::cli::cmd_depth, "estimate a photo's disparity, write a 16-bit PNG"},
 };
 
 void print_usage(FILE* out) {
