@@ -1,0 +1,234 @@
+#include "render/video_out.h"
+
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <opencv2/core/utils/logger.hpp>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <vector>
+
+extern char** environ;
+
+namespace ampi {
+namespace fs = std::filesystem;
+namespace {
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw std::runtime_error(path + ": " + problem);
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  return ext;
+}
+
+// "out/dir/" and "out/dir" name the same destination.
+std::string without_trailing_slashes(std::string path) {
+  while (path.size() > 1 && path.back() == '/') path.pop_back();
+  return path;
+}
+
+// A hidden name beside the destination, unique to this process, so the final rename
+// stays within one file system. Videos keep their extension: it selects the format.
+std::string staging_name(const std::string& path, Container c) {
+  const fs::path p(path);
+  std::string name = "." + p.filename().string() + ".partial-" + std::to_string(::getpid());
+  if (c == Container::Mp4) name += ".mp4";
+  if (c == Container::Png) name += ".png";
+  return (p.parent_path() / name).string();
+}
+
+// Moves `staging` to `dest`; a previous `dest` is set aside first and deleted only after
+// the new one is in place (rename cannot replace a directory).
+void move_into_place(const std::string& staging, const std::string& dest) {
+  const fs::path d(dest);
+  fs::path aside;
+  if (fs::symlink_status(d).type() != fs::file_type::not_found) {
+    aside = d.parent_path() / ("." + d.filename().string() + ".replaced-" + std::to_string(::getpid()));
+    fs::rename(d, aside);
+  }
+  std::error_code error;
+  fs::rename(staging, d, error);
+  if (error) {
+    if (!aside.empty()) fs::rename(aside, d, error);
+    fail(dest, "cannot move the finished output into place");
+  }
+  if (!aside.empty()) fs::remove_all(aside, error);
+}
+
+int run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv;
+  for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
+  argv.push_back(nullptr);
+  pid_t pid;
+  if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
+  int status = 0;
+  if (waitpid(pid, &status, 0) < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+}  // namespace
+
+Container container_for_path(const std::string& path) {
+  const std::string ext = lower_extension(without_trailing_slashes(path));
+  if (ext == ".mp4") return Container::Mp4;
+  if (ext == ".gif") return Container::Gif;
+  if (ext == ".png") return Container::Png;
+  return Container::PngSequence;
+}
+
+const char* container_name(Container c) {
+  switch (c) {
+    case Container::Mp4: return "mp4";
+    case Container::Gif: return "gif";
+    case Container::PngSequence: return "png sequence";
+    case Container::Png: return "png";
+  }
+  return "?";
+}
+
+bool program_on_path(const std::string& name) {
+  const char* path = std::getenv("PATH");
+  if (!path) return false;
+  std::string dirs = path;
+  size_t start = 0;
+  while (start <= dirs.size()) {
+    const size_t end = std::min(dirs.find(':', start), dirs.size());
+    const std::string dir = dirs.substr(start, end - start);
+    const std::string candidate = (dir.empty() ? "." : dir) + "/" + name;
+    if (::access(candidate.c_str(), X_OK) == 0 && fs::is_regular_file(candidate)) return true;
+    start = end + 1;
+  }
+  return false;
+}
+
+FrameWriter::FrameWriter(const std::string& path, Container container, double fps, bool overwrite)
+    : path_(without_trailing_slashes(path)), container_(container), fps_(fps), overwrite_(overwrite) {
+  if (path_.empty()) throw std::runtime_error("the output path is empty");
+  if (!(fps > 0)) fail(path_, "fps must be positive");
+  if (!overwrite && fs::symlink_status(path_).type() != fs::file_type::not_found)
+    fail(path_, "already exists (use --force to replace it)");
+  const fs::path parent = fs::path(path_).parent_path();
+  if (!parent.empty() && !fs::is_directory(parent)) fail(path_, "directory " + parent.string() + " does not exist");
+  if (container == Container::Gif && !program_on_path("ffmpeg"))
+    fail(path_, "GIF output needs the ffmpeg program, which is not on PATH (install ffmpeg, or write .mp4 or PNG frames)");
+  staging_ = staging_name(path_, container);
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);  // left by an earlier process with our pid
+  if (container == Container::PngSequence || container == Container::Gif) fs::create_directory(staging_);
+}
+
+FrameWriter::~FrameWriter() {
+  if (finished_) return;
+  video_.release();
+  std::error_code ignored;
+  fs::remove_all(staging_, ignored);
+  fs::remove(staging_ + ".gif", ignored);
+}
+
+void FrameWriter::open_video(cv::Size size) {
+  // The FFmpeg backend logs its own complaint when a codec is missing; we report ours.
+  const auto level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
+  video_.open(staging_, cv::VideoWriter::fourcc('a', 'v', 'c', '1'), fps_, size);
+  if (!video_.isOpened()) {
+    video_.open(staging_, cv::VideoWriter::fourcc('m', 'p', '4', 'v'), fps_, size);
+    note_ = "no H.264 encoder in this OpenCV build: wrote MPEG-4 Part 2 video instead";
+  }
+  cv::utils::logging::setLogLevel(level);
+  if (!video_.isOpened()) fail(path_, "OpenCV cannot write MP4 video here (no FFmpeg or GStreamer backend?)");
+}
+
+void FrameWriter::write_png(const std::string& file, const cv::Mat& bgr) const {
+  bool written = false;
+  try {
+    written = cv::imwrite(file, bgr);
+  } catch (const cv::Exception&) {
+    written = false;
+  }
+  if (!written) fail(path_, "cannot write PNG image " + file);
+}
+
+void FrameWriter::add(const cv::Mat& bgr) {
+  if (finished_) throw std::logic_error("FrameWriter::add after finish");
+  if (bgr.type() != CV_8UC3 || bgr.empty()) throw std::invalid_argument("FrameWriter::add needs a CV_8UC3 frame");
+  if (frames_ == 0) size_ = bgr.size();
+  if (bgr.size() != size_) throw std::invalid_argument("FrameWriter::add: the frame size changed");
+  if (container_ == Container::Png && frames_ == 1) fail(path_, "a .png output holds a single frame");
+  char name[32];
+  std::snprintf(name, sizeof name, "frame_%06d.png", frames_);
+  switch (container_) {
+    case Container::Mp4: {
+      cv::Mat even = bgr;
+      if (bgr.cols % 2 || bgr.rows % 2)
+        cv::copyMakeBorder(bgr, even, 0, bgr.rows % 2, 0, bgr.cols % 2, cv::BORDER_REPLICATE);
+      if (frames_ == 0) open_video(even.size());
+      video_.write(even);
+      break;
+    }
+    case Container::Gif:
+    case Container::PngSequence: write_png((fs::path(staging_) / name).string(), bgr); break;
+    case Container::Png: write_png(staging_, bgr); break;
+  }
+  ++frames_;
+}
+
+// Two passes in one filter graph: palettegen finds the 256 colours that suit the whole
+// clip, paletteuse maps every frame onto them.
+void FrameWriter::encode_gif() const {
+  const int status = run_program(
+      {"ffmpeg", "-v", "error", "-nostdin", "-y", "-framerate", std::to_string(fps_), "-i",
+       (fs::path(staging_) / "frame_%06d.png").string(), "-filter_complex",
+       "split[frames][copy];[copy]palettegen[palette];[frames][palette]paletteuse", "-loop", "0",
+       staging_ + ".gif"});
+  if (status != 0) fail(path_, "ffmpeg could not make the GIF (exit status " + std::to_string(status) + ")");
+}
+
+void FrameWriter::finish() {
+  if (finished_) return;
+  if (frames_ == 0) fail(path_, "no frames were rendered");
+  if (!overwrite_ && fs::symlink_status(path_).type() != fs::file_type::not_found)
+    fail(path_, "appeared while rendering; not replaced (use --force to replace it)");
+  video_.release();
+  if (container_ == Container::Gif) {
+    encode_gif();
+    move_into_place(staging_ + ".gif", path_);
+    std::error_code ignored;
+    fs::remove_all(staging_, ignored);
+  } else {
+    move_into_place(staging_, path_);
+  }
+  finished_ = true;
+}
+
+StereoPoses stereo_poses(const Pose& centre, double baseline) {
+  // Moving the camera by d in its own frame: X_eye = X_new - d, so t_eye = t - d.
+  StereoPoses eyes{centre, centre};
+  eyes.left.t[0] += 0.5 * baseline;
+  eyes.right.t[0] -= 0.5 * baseline;
+  return eyes;
+}
+
+cv::Mat side_by_side(const cv::Mat& left, const cv::Mat& right) {
+  cv::Mat out;
+  cv::hconcat(left, right, out);
+  return out;
+}
+
+cv::Mat anaglyph(const cv::Mat& left, const cv::Mat& right) {
+  CV_Assert(left.size() == right.size() && left.type() == CV_8UC3 && right.type() == CV_8UC3);
+  cv::Mat out(left.size(), CV_8UC3);
+  const cv::Mat sources[] = {left, right};
+  // BGR: blue and green (cyan) from the right eye, red from the left.
+  const int from_to[] = {3, 0, 4, 1, 2, 2};
+  cv::mixChannels(sources, 2, &out, 1, from_to, 3);
+  return out;
+}
+
+}  // namespace ampi
