@@ -334,7 +334,7 @@ def ground_plane():
 # ----------------------------------------------------------------------------------
 # Camera
 
-@dataclass
+@dataclass(frozen=True)
 class Camera:
     width: int
     height: int
@@ -344,11 +344,11 @@ class Camera:
     roll_deg: float = 0.0
     yaw_deg: float = 0.0        # positive turns towards +x
 
-    @property
+    @functools.cached_property
     def focal(self):
         return self.width / 2 / math.tan(math.radians(self.fov_x_deg) / 2)
 
-    @property
+    @functools.cached_property
     def rotation(self):
         """Camera-to-world rotation: its columns are the camera's x, y, z axes in the world."""
         flip_y = np.diag([1.0, -1.0, 1.0])      # camera y points down, world y up
@@ -953,7 +953,7 @@ class SceneSampler:
         trunk_radius = height * rng.uniform(0.02, 0.05)
         parts = [SceneObject(Cylinder((x, base_y + height / 2, z), trunk_radius, height / 2),
                              self.object_material(1.0))]
-        crown = height * rng.uniform(0.3, 0.6)
+        crown = min(height * rng.uniform(0.3, 0.6), 0.8 * z * self.half_tan)
         center = (x, base_y + height + crown * 0.5, z)
         if rng.random() < 0.5:
             parts.append(SceneObject(Sphere(center, crown), self.object_material(crown * 2)))
@@ -1209,13 +1209,17 @@ def contact_sheet(path, seeds, tile=(192, 144), columns=3):
 
 
 def benchmark(count, workers, size):
-    """Prints images per second, in this process and through a DataLoader."""
+    """Prints images per second, in this process and through a DataLoader.
+
+    The machine is often shared, so the CPU time per image and the load average are
+    printed too: 1000 / (CPU ms per image) is the rate of one core of one's own."""
     texture_pool('train')
-    start = time.perf_counter()
+    wall, cpu = time.perf_counter(), time.process_time()
     for seed in range(count):
         render_scene(seed, *size)
-    single = count / (time.perf_counter() - start)
-    print(f'render_scene {size[0]}x{size[1]}: {single:.1f} images/s in one process')
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
+    print(f'render_scene {size[0]}x{size[1]}: {count / wall:.1f} images/s in one process, '
+          f'{1000 * cpu / count:.1f} ms of CPU per image ({count / cpu:.1f} images/s per free core)')
     if workers > 0:
         loader = torch.utils.data.DataLoader(SceneDataset(count, count, size), batch_size=8,
                                              num_workers=workers)
@@ -1224,6 +1228,7 @@ def benchmark(count, workers, size):
             pass
         rate = count / (time.perf_counter() - start)
         print(f'SceneDataset + DataLoader, {workers} workers: {rate:.1f} images/s')
+    print('load average (1, 5, 15 min): {:.1f} {:.1f} {:.1f} on {} cores'.format(*os.getloadavg(), os.cpu_count()))
 
 
 def main(argv=None):
