@@ -496,7 +496,7 @@ class Scene:
 class GBuffer:
     depth: np.ndarray         # (H, W) float32 camera depth, inf where the sky shows
     ids: np.ndarray           # (H, W) int16 index of the visible object, -1 for sky
-    boxes: list               # per object: its screen box, None when off screen
+    object_count: int
     directions: np.ndarray    # (3, H, W) ray directions
 
 
@@ -509,10 +509,8 @@ def raycast(scene):
     if len(scene.objects) > np.iinfo(np.int16).max:
         raise ValueError(f'{len(scene.objects)} objects: at most {np.iinfo(np.int16).max} per scene')
     ids = np.full((camera.height, camera.width), -1, dtype=np.int16)
-    boxes = []
     for index, obj in enumerate(scene.objects):
         box = camera.screen_box(obj.shape.corners())
-        boxes.append(box)
         if box is None:
             continue
         t = obj.shape.intersect(origin, directions[(slice(None),) + box], NEAR_CLIP)
@@ -520,7 +518,7 @@ def raycast(scene):
         nearer = t < region
         region[nearer] = t[nearer]
         ids[box][nearer] = index
-    return GBuffer(depth, ids, boxes, directions)
+    return GBuffer(depth, ids, len(scene.objects), directions)
 
 
 def disparity_of(gbuffer):
@@ -535,7 +533,7 @@ def pixels_by_object(gbuffer):
     """Flat pixel indices of each object's visible pixels (one radix sort of the ids)."""
     ids = gbuffer.ids.reshape(-1)
     order = np.argsort(ids, kind='stable')
-    ends = np.cumsum(np.bincount(ids.astype(np.int32) + 1, minlength=len(gbuffer.boxes) + 1))
+    ends = np.cumsum(np.bincount(ids.astype(np.int32) + 1, minlength=gbuffer.object_count + 1))
     return [order[start:end] for start, end in zip(ends[:-1], ends[1:])]
 
 

@@ -3,7 +3,6 @@
 
 Run: /usr/bin/python3 training/test_scenes.py (ctest runs it as training_scenes)."""
 
-import math
 import os
 import sys
 import tempfile
@@ -114,6 +113,43 @@ class HandBuiltScenes(unittest.TestCase):
         _, disparity = scenes.render(plain_scene(camera, [wall, cutout]))
         self.assertAlmostEqual(float(disparity[pixel_of(camera, (-0.5, 1.5, 5))]), 0.2, places=5)
         self.assertAlmostEqual(float(disparity[pixel_of(camera, (0.5, 1.5, 5))]), 0.1, places=6)
+
+
+def mirrored(value, size):
+    """Plain reference of the mirrored repeat into [0, size]."""
+    value = value % (2 * size)
+    return 2 * size - value if value > size else value
+
+
+class Texturing(unittest.TestCase):
+    def test_bilinear_sampling_matches_a_plain_loop(self):
+        seed = 7
+        rng = np.random.default_rng(seed)
+        image = rng.integers(0, 256, (3, 12, 16), dtype=np.uint8)
+        crop = (2.0, 3.0, 9.0, 7.0)
+        x = rng.uniform(-30, 30, 60).astype(np.float32)
+        y = rng.uniform(-30, 30, 60).astype(np.float32)
+        got = scenes.sample_bilinear(torch.from_numpy(image), crop, x, y)
+        for i in range(x.size):
+            px = mirrored(float(x[i]), crop[2] - 1) + crop[0]
+            py = mirrored(float(y[i]), crop[3] - 1) + crop[1]
+            x0, y0 = int(px), int(py)
+            fx, fy = px - x0, py - y0
+            x1, y1 = min(x0 + 1, 15), min(y0 + 1, 11)
+            texel = image.astype(np.float64) / 255
+            value = ((texel[:, y0, x0] * (1 - fx) + texel[:, y0, x1] * fx) * (1 - fy)
+                     + (texel[:, y1, x0] * (1 - fx) + texel[:, y1, x1] * fx) * fy)
+            np.testing.assert_allclose(got[:, i], value ** 2, atol=1e-4,
+                                       err_msg=f'seed {seed}, sample {i} at ({x[i]}, {y[i]})')
+
+    def test_mip_levels_average_two_by_two_blocks(self):
+        seed = 3
+        image = np.random.default_rng(seed).integers(0, 256, (40, 36, 3), dtype=np.uint8)
+        levels = scenes.mip_pyramid(image)
+        self.assertEqual([tuple(level.shape) for level in levels], [(3, 40, 36), (3, 20, 18), (3, 10, 9)])
+        blocks = image.astype(np.float64).reshape(20, 2, 18, 2, 3).mean(axis=(1, 3))
+        np.testing.assert_allclose(levels[1].numpy().transpose(1, 2, 0), blocks, atol=0.5,
+                                   err_msg=f'seed {seed}')
 
 
 class RandomScenes(unittest.TestCase):
