@@ -18,8 +18,10 @@ namespace ampi {
 constexpr int kDisparityLevels = 256;
 
 // Every constant of the adaptive algorithm. eps, xi and threshold are the paper's
-// values; the paper gives no filter sizes, so these defaults are ours, chosen so that a
-// depth step of more than about 5 levels is a Canny edge and a smooth ramp is not.
+// values; the paper gives no filter sizes, so these defaults are ours. On the 0..255
+// map the 3x3 Sobel response is 4 s across a step of s levels and 8 r along a slope of
+// r levels per pixel: an edge starts at a step of about 13 levels (canny_high) and
+// continues down to 5 (canny_low), while slopes under 2.5 levels per pixel never count.
 struct SlicingParams {
   int max_planes = 8;         // at most this many planes, 1..255 (the paper's maximum count)
   double eps = 0.001;         // floor of h in the transition index's denominator
