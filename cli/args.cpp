@@ -14,6 +14,10 @@ void ArgParser::flag(const std::string& name, bool* target) {
   options_.push_back({name, false, [target](const std::string&) { *target = true; }});
 }
 
+void ArgParser::flag(const std::string& name, std::function<void()> apply) {
+  options_.push_back({name, false, [apply](const std::string&) { apply(); }});
+}
+
 void ArgParser::option(const std::string& name, std::string* target) {
   options_.push_back({name, true, [target](const std::string& v) { *target = v; }});
 }

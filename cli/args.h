@@ -13,6 +13,7 @@ class ArgParser {
   ArgParser(std::string command, std::string usage);
 
   void flag(const std::string& name, bool* target);
+  void flag(const std::string& name, std::function<void()> apply);
   void option(const std::string& name, std::string* target);
   void option(const std::string& name, int* target, int lo, int hi);
   void option(const std::string& name, double* target, double lo, double hi);

@@ -16,6 +16,8 @@
 #include "pipeline/make_mpi.h"
 #include "pipeline/output_staging.h"
 #include "pipeline/photo_io.h"
+#include "pipeline/video.h"
+#include "render/viewer.h"
 
 namespace fs = std::filesystem;
 
@@ -28,6 +30,8 @@ const char kUsage[] =
     "Turns each photo into an adaptive multiplane image and its outputs:\n"
     "  DIR/depth.png   16-bit disparity (larger = nearer) at the photo's size\n"
     "  DIR/mpi/        layer_XX.png (RGBA, back to front) and mpi.json\n"
+    "  DIR/video.mp4   a parallax video (video.gif or frames/ with --video-format)\n"
+    "  DIR/viewer.html a standalone page showing the MPI with parallax (mouse, touch, tilt)\n"
     "Several photos, or a folder of photos: one sub-folder of DIR each, named after the\n"
     "photo. A photo that fails is reported and skipped; the exit code is then 1.\n"
     "\n"
@@ -46,6 +50,15 @@ const char kUsage[] =
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
     "  --inpaint-weights FILE  inpainting network weight file instead of the bundled one\n"
     "  --fov DEG               assumed horizontal field of view (default 60)\n"
+    "  --trajectory NAME       circle, swing, zoom-in or dolly-zoom (default circle)\n"
+    "  --keyframes FILE        a JSON keyframe file instead of --trajectory\n"
+    "  --frames N              frames of the video (default 90)\n"
+    "  --fps N                 frames per second (default 30)\n"
+    "  --amplitude A           camera travel, fraction of the nearest plane's depth (default 0.05)\n"
+    "  --boomerang, --one-way  back and forth, or once (default: by trajectory)\n"
+    "  --stereo MODE           mono, sbs (side by side) or anaglyph (red-cyan) (default mono)\n"
+    "  --video-format F        mp4, gif (needs ffmpeg) or png (a PNG sequence) (default mp4)\n"
+    "  --no-video              skip the video\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --quiet                 no progress on stderr\n";
 
@@ -55,7 +68,9 @@ struct RunArgs {
   bool force = false;
   bool quiet = false;
   int threads = 0;
+  bool video = true;
   MpiOptions mpi;
+  VideoOptions video_options;
 };
 
 RunArgs parse(int argc, char** argv, bool& help) {
@@ -80,8 +95,22 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
   p.option("--fov", &a.mpi.fov_degrees, 1, 179);
+  PathOptions& path = a.video_options.path;
+  p.option("--trajectory", [&](const std::string& v) { path.kind = parse_path_kind(v); });
+  p.option("--keyframes", &a.video_options.keyframes);
+  p.option("--frames", &path.frames, 1, kMaxPathFrames);
+  p.option("--fps", &path.fps, 1, 240);
+  p.option("--amplitude", &path.amplitude, 1e-4, 0.9);
+  p.flag("--boomerang", [&] { path.boomerang = true; });
+  p.flag("--one-way", [&] { path.boomerang = false; });
+  p.option("--stereo", [&](const std::string& v) { a.video_options.stereo = parse_stereo_mode(v); });
+  p.option("--video-format",
+           [&](const std::string& v) { a.video_options.container = parse_video_format(v); });
+  bool no_video = false;
+  p.flag("--no-video", &no_video);
   help = !p.parse(argc, argv);
   if (help) return a;
+  a.video = !no_video;
   if (a.inputs.empty()) throw std::runtime_error("missing PHOTO (see ampi run --help)");
   if (a.output.empty()) throw std::runtime_error("missing -o DIR (see ampi run --help)");
   return a;
@@ -115,9 +144,9 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
   return photos;
 }
 
-void run_one(MpiMaker& maker, const std::string& photo, const std::string& destination, bool force,
-             Progress& progress) {
-  OutputStaging staging(destination, force);
+void run_one(MpiMaker& maker, const RunArgs& a, const std::string& photo,
+             const std::string& destination, Progress& progress) {
+  OutputStaging staging(destination, a.force);
   const cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo); });
   const MpiResult result = maker.make(bgr, photo, progress);
   progress.stage("write mpi", [&] {
@@ -125,6 +154,12 @@ void run_one(MpiMaker& maker, const std::string& photo, const std::string& desti
     write_depth_png16(result.disparity, (dir / "depth.png").string());
     write_mpi(result.mpi, (dir / "mpi").string());
   });
+  if (a.video)
+    progress.stage("video", [&] {
+      const fs::path file = fs::path(staging.dir()) / video_file_name(a.video_options.container);
+      return write_video(result.mpi, a.video_options, file.string(), false);
+    });
+  progress.stage("viewer", [&] { return write_viewer(result.mpi, staging.dir()); });
   staging.commit();
   progress.note(photo + ": " + std::to_string(result.mpi.planes.size()) + " planes, inpainted by " +
                 result.inpainter + " -> " + destination);
@@ -151,7 +186,7 @@ int cmd_run(int argc, char** argv) {
     const std::string destination = one ? a.output : (fs::path(a.output) / fs::path(photo).stem()).string();
     if (!one) progress.note(photo);
     try {
-      run_one(maker, photo, destination, a.force, progress);
+      run_one(maker, a, photo, destination, progress);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ampi run: %s\n", e.what());
       ++failed;

@@ -1,0 +1,35 @@
+// The parallax video of an MPI: a camera path (a named move or a keyframe file), mono or
+// stereo, into an MP4, a GIF or a PNG sequence.
+#pragma once
+#include <string>
+
+#include "engine/thread_pool.h"
+#include "mpi/mpi.h"
+#include "render/render_frames.h"
+#include "render/trajectory.h"
+#include "render/video_out.h"
+
+namespace ampi {
+
+struct VideoOptions {
+  PathOptions path;           // the named move, frames, fps, amplitude, boomerang
+  std::string keyframes;      // a keyframe file instead of the named move
+  StereoMode stereo = StereoMode::Mono;
+  double baseline = 0;        // between the eyes, scene units; 0: 6% of the nearest depth
+  Container container = Container::Mp4;
+};
+
+// "mp4", "gif", "png" (a PNG sequence); throws std::invalid_argument otherwise.
+Container parse_video_format(const std::string& name);
+// "mono", "sbs", "anaglyph"; throws std::invalid_argument otherwise.
+StereoMode parse_stereo_mode(const std::string& name);
+
+// video.mp4, video.gif or frames/ (a PNG sequence).
+std::string video_file_name(Container container);
+
+// Renders the whole path into `path` (staged by FrameWriter: all or nothing). Returns
+// the number of frames written.
+int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
+                bool overwrite, ThreadPool& pool = default_pool());
+
+}  // namespace ampi
