@@ -1,4 +1,6 @@
-// NEON kernels along the channel axis: gated output, concat, squeeze-excite parts.
+// NEON kernels along the channel axis: gated output, concat, squeeze-excite parts
+// (channel_scale stays the reference: see kernels/reference/channels.cpp).
+// Bodies are lane-generic (see neon_channels.h): 4 channels a vector, leftovers scalar.
 #include "kernels/arm/neon_channels.h"
 #include "kernels/arm/neon_kernels.h"
 #include "kernels/arm/neon_math.h"
@@ -11,49 +13,40 @@ void gated_output(const float* in, int64_t pixels, int c, ActivationSpec act, fl
     const float* feature = in + p * 2 * c;
     const float* gate = feature + c;
     float* dst = out + p * c;
-    channels.each([&](int j, auto v) {
-      v.store(dst + j, vmulq_f32(activate(v.load(feature + j), act), sigmoid(v.load(gate + j))));
+    channels.each([&](int j, auto lane) {
+      lane.store(dst + j, times(activate(lane.load(feature + j), act), sigmoid(lane.load(gate + j))));
     });
   }
 }
 
 void concat_channels(const float* a, int ca, const float* b, int cb, int64_t pixels, float* out) {
-  const Channels channels_a(ca), channels_b(cb);
   for (int64_t p = 0; p < pixels; ++p) {
-    const float* src_a = a + p * ca;
-    const float* src_b = b + p * cb;
     float* dst = out + p * (ca + cb);
-    channels_a.each([&](int j, auto v) { v.store(dst + j, v.load(src_a + j)); });
-    channels_b.each([&](int j, auto v) { v.store(dst + ca + j, v.load(src_b + j)); });
+    copy_floats(a + p * ca, ca, dst);
+    copy_floats(b + p * cb, cb, dst + ca);
   }
 }
 
 // Channel blocks outermost: each block's running sum stays in a register, and adding in
 // pixel order gives the reference's result bit for bit.
 void channel_sum(const float* in, int64_t pixels, int c, float* sum) {
-  Channels(c).each([&](int j, auto v) {
-    float32x4_t acc = vdupq_n_f32(0.0f);
-    for (int64_t p = 0; p < pixels; ++p) acc = vaddq_f32(acc, v.load(in + p * c + j));
-    v.store(sum + j, acc);
+  Channels(c).each([&](int j, auto lane) {
+    auto acc = lane.splat(0.0f);
+    for (int64_t p = 0; p < pixels; ++p) acc = plus(acc, lane.load(in + p * c + j));
+    lane.store(sum + j, acc);
   });
-}
-
-void channel_scale(const float* in, int64_t pixels, int c, const float* scale, float* out) {
-  const Channels channels(c);
-  for (int64_t p = 0; p < pixels; ++p)
-    channels.each([&](int j, auto v) {
-      v.store(out + p * c + j, vmulq_f32(v.load(in + p * c + j), v.load(scale + j)));
-    });
 }
 
 void dense(const float* w, const float* bias, int rows, int cols, const float* x,
            ActivationSpec act, float* y) {
-  const Channels channels(cols);
   for (int r = 0; r < rows; ++r) {
     const float* row = w + static_cast<int64_t>(r) * cols;
     float32x4_t acc = vdupq_n_f32(0.0f);
-    channels.each([&](int j, auto v) { acc = vfmaq_f32(acc, v.load(row + j), v.load(x + j)); });
-    y[r] = ampi::activate((bias ? bias[r] : 0.0f) + vaddvq_f32(acc), act);
+    int j = 0;
+    for (; j + 4 <= cols; j += 4) acc = vfmaq_f32(acc, vld1q_f32(row + j), vld1q_f32(x + j));
+    float sum = vaddvq_f32(acc);
+    for (; j < cols; ++j) sum += row[j] * x[j];
+    y[r] = ampi::activate((bias ? bias[r] : 0.0f) + sum, act);
   }
 }
 

@@ -1,46 +1,63 @@
-// Loops over the channels of one NHWC pixel in 4-float vectors, the last one partial.
-// Include only from *_neon.cpp files. Same pattern as kernels/x86/avx2_channels.h; NEON
-// has no masked loads, so the partial vector goes through a 4-float buffer.
+// Loops over the channels of one NHWC pixel: 4-float vectors, then single floats for the
+// channels left over. Include only from *_neon.cpp files. Same pattern as
+// kernels/x86/avx2_channels.h: kernel bodies are generic lambdas written with the
+// lane-generic arithmetic below (NEON has no masked loads; a bounce buffer for the
+// partial vector stalls store forwarding).
 #pragma once
 #include <arm_neon.h>
 
-#include <cstring>
+#include <cmath>
+#include <cstdint>
 
 namespace ampi::neon {
 
-struct FullVector {
-  float32x4_t load(const float* p) const { return vld1q_f32(p); }
-  void store(float* p, float32x4_t v) const { vst1q_f32(p, v); }
+struct Vector {
+  static float32x4_t load(const float* p) { return vld1q_f32(p); }
+  static void store(float* p, float32x4_t v) { vst1q_f32(p, v); }
+  static float32x4_t splat(float x) { return vdupq_n_f32(x); }
 };
 
-// Reads and writes only the first n lanes; the other lanes load as 0.
-struct PartialVector {
-  int n;
-  float32x4_t load(const float* p) const {
-    float lanes[4] = {0.0f, 0.0f, 0.0f, 0.0f};
-    std::memcpy(lanes, p, sizeof(float) * n);
-    return vld1q_f32(lanes);
-  }
-  void store(float* p, float32x4_t v) const {
-    float lanes[4];
-    vst1q_f32(lanes, v);
-    std::memcpy(p, lanes, sizeof(float) * n);
-  }
+struct Scalar {
+  static float load(const float* p) { return *p; }
+  static void store(float* p, float v) { *p = v; }
+  static float splat(float x) { return x; }
 };
+
+inline float32x4_t plus(float32x4_t a, float32x4_t b) { return vaddq_f32(a, b); }
+inline float32x4_t minus(float32x4_t a, float32x4_t b) { return vsubq_f32(a, b); }
+inline float32x4_t times(float32x4_t a, float32x4_t b) { return vmulq_f32(a, b); }
+inline float32x4_t fmadd(float32x4_t a, float32x4_t b, float32x4_t c) { return vfmaq_f32(c, a, b); }
+inline float plus(float a, float b) { return a + b; }
+inline float minus(float a, float b) { return a - b; }
+inline float times(float a, float b) { return a * b; }
+inline float fmadd(float a, float b, float c) { return a * b + c; }
+inline float sigmoid(float x) { return 1.0f / (1.0f + std::exp(-x)); }
 
 class Channels {
  public:
-  explicit Channels(int c) : c_(c), whole_(c - c % 4), tail_{c % 4} {}
-  // Calls body(j, accessor) for j = 0, 4, 8, ... < c.
+  explicit Channels(int c) : c_(c) {}
+  // Calls body(j, Vector{}) for j = 0, 4, 8, ... while 4 channels remain, then
+  // body(j, Scalar{}) for each remaining channel j.
   template <class Body>
   void each(Body&& body) const {
-    for (int j = 0; j < whole_; j += 4) body(j, FullVector{});
-    if (whole_ < c_) body(whole_, tail_);
+    int j = 0;
+    for (; j + 4 <= c_; j += 4) body(j, Vector{});
+    for (; j < c_; ++j) body(j, Scalar{});
   }
 
  private:
-  int c_, whole_;
-  PartialVector tail_;
+  int c_;
 };
+
+// Copies n floats between buffers that do not overlap, with no scalar remainder from 4
+// floats on: whole vectors, then one more ending exactly at n.
+inline void copy_floats(const float* src, int64_t n, float* dst) {
+  if (n < 4) {
+    for (int64_t j = 0; j < n; ++j) dst[j] = src[j];
+    return;
+  }
+  for (int64_t j = 0; j + 4 <= n; j += 4) vst1q_f32(dst + j, vld1q_f32(src + j));
+  if (n % 4) vst1q_f32(dst + n - 4, vld1q_f32(src + n - 4));
+}
 
 }  // namespace ampi::neon

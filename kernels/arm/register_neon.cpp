@@ -9,7 +9,6 @@ void fill_neon_kernels(KernelTable& t) {
   t.gated_output = neon::gated_output;
   t.concat_channels = neon::concat_channels;
   t.channel_sum = neon::channel_sum;
-  t.channel_scale = neon::channel_scale;
   t.dense = neon::dense;
   t.haar_dwt = neon::haar_dwt;
   t.haar_idwt = neon::haar_idwt;

@@ -1,5 +1,6 @@
 // NEON 2x resampling kernels: Haar DWT and inverse, nearest and bilinear upscaling.
-// Bandwidth-bound; the vectors pay by moving 4 channels per load and store.
+// Bandwidth-bound; the vectors pay by moving 4 channels per load and store. Bodies are
+// lane-generic (see neon_channels.h): leftover channels run as scalar code.
 #include <algorithm>
 
 #include "kernels/arm/neon_channels.h"
@@ -15,15 +16,16 @@ void haar_dwt(const float* in, int /*h*/, int w, int c, int row_begin, int row_e
     const float* bottom = top + static_cast<int64_t>(w) * c;
     float* dst = out + static_cast<int64_t>(y) * (w / 2) * 4 * c;
     for (int x = 0; x < w / 2; ++x, top += pixel_pair, bottom += pixel_pair, dst += 4 * c)
-      channels.each([&](int j, auto v) {
-        const float32x4_t x00 = v.load(top + j), x01 = v.load(top + c + j);
-        const float32x4_t x10 = v.load(bottom + j), x11 = v.load(bottom + c + j);
-        const float32x4_t top_sum = vaddq_f32(x00, x01), top_diff = vsubq_f32(x00, x01);
-        const float32x4_t bottom_sum = vaddq_f32(x10, x11), bottom_diff = vsubq_f32(x10, x11);
-        v.store(dst + j, vmulq_n_f32(vaddq_f32(top_sum, bottom_sum), 0.5f));
-        v.store(dst + c + j, vmulq_n_f32(vaddq_f32(top_diff, bottom_diff), 0.5f));
-        v.store(dst + 2 * c + j, vmulq_n_f32(vsubq_f32(top_sum, bottom_sum), 0.5f));
-        v.store(dst + 3 * c + j, vmulq_n_f32(vsubq_f32(top_diff, bottom_diff), 0.5f));
+      channels.each([&](int j, auto lane) {
+        const auto half = lane.splat(0.5f);
+        const auto x00 = lane.load(top + j), x01 = lane.load(top + c + j);
+        const auto x10 = lane.load(bottom + j), x11 = lane.load(bottom + c + j);
+        const auto top_sum = plus(x00, x01), top_diff = minus(x00, x01);
+        const auto bottom_sum = plus(x10, x11), bottom_diff = minus(x10, x11);
+        lane.store(dst + j, times(plus(top_sum, bottom_sum), half));
+        lane.store(dst + c + j, times(plus(top_diff, bottom_diff), half));
+        lane.store(dst + 2 * c + j, times(minus(top_sum, bottom_sum), half));
+        lane.store(dst + 3 * c + j, times(minus(top_diff, bottom_diff), half));
       });
   }
 }
@@ -35,52 +37,54 @@ void haar_idwt(const float* in, int /*h*/, int w, int c, int row_begin, int row_
     float* top = out + static_cast<int64_t>(2 * y) * 2 * w * c;
     float* bottom = top + static_cast<int64_t>(2 * w) * c;
     for (int x = 0; x < w; ++x, src += 4 * c, top += 2 * c, bottom += 2 * c)
-      channels.each([&](int j, auto v) {
-        const float32x4_t ll = v.load(src + j), lh = v.load(src + c + j);
-        const float32x4_t hl = v.load(src + 2 * c + j), hh = v.load(src + 3 * c + j);
+      channels.each([&](int j, auto lane) {
+        const auto half = lane.splat(0.5f);
+        const auto ll = lane.load(src + j), lh = lane.load(src + c + j);
+        const auto hl = lane.load(src + 2 * c + j), hh = lane.load(src + 3 * c + j);
         // x00 = (s + t) / 2, x01 = (s - t) / 2 with s = LL + HL, t = LH + HH; the bottom
         // row likewise with the differences.
-        const float32x4_t s = vaddq_f32(ll, hl), t = vaddq_f32(lh, hh);
-        const float32x4_t sd = vsubq_f32(ll, hl), td = vsubq_f32(lh, hh);
-        v.store(top + j, vmulq_n_f32(vaddq_f32(s, t), 0.5f));
-        v.store(top + c + j, vmulq_n_f32(vsubq_f32(s, t), 0.5f));
-        v.store(bottom + j, vmulq_n_f32(vaddq_f32(sd, td), 0.5f));
-        v.store(bottom + c + j, vmulq_n_f32(vsubq_f32(sd, td), 0.5f));
+        const auto s = plus(ll, hl), t = plus(lh, hh);
+        const auto sd = minus(ll, hl), td = minus(lh, hh);
+        lane.store(top + j, times(plus(s, t), half));
+        lane.store(top + c + j, times(minus(s, t), half));
+        lane.store(bottom + j, times(plus(sd, td), half));
+        lane.store(bottom + c + j, times(minus(sd, td), half));
       });
   }
 }
 
 void resize2x_nearest(const float* in, int /*h*/, int w, int c, int row_begin, int row_end, float* out) {
-  const Channels channels(c);
+  const int64_t out_row = 2 * static_cast<int64_t>(w) * c;
   for (int y = row_begin; y < row_end; ++y) {
     const float* src = in + static_cast<int64_t>(y) * w * c;
-    float* top = out + static_cast<int64_t>(2 * y) * 2 * w * c;
-    float* bottom = top + static_cast<int64_t>(2 * w) * c;
-    for (int x = 0; x < w; ++x, src += c, top += 2 * c, bottom += 2 * c)
-      channels.each([&](int j, auto v) {
-        const float32x4_t value = v.load(src + j);
-        v.store(top + j, value);
-        v.store(top + c + j, value);
-        v.store(bottom + j, value);
-        v.store(bottom + c + j, value);
-      });
+    float* top = out + 2 * y * out_row;
+    float* dst = top;
+    for (int x = 0; x < w; ++x, src += c, dst += 2 * c) {
+      copy_floats(src, c, dst);
+      copy_floats(src, c, dst + c);
+    }
+    copy_floats(top, out_row, top + out_row);  // the second output row repeats the first
   }
 }
 
-// Fixed 3/4 : 1/4 weights, vertical blend then horizontal; see resample_avx2.cpp.
+// With half-pixel centres a 2x upscale has fixed weights: output 2i blends input i and
+// i-1 by 3/4 : 1/4, output 2i+1 blends i and i+1, neighbours clamped at the border. One
+// output row is the vertical blend `near * 3/4 + far * 1/4` of two input rows, then the
+// same blend horizontally.
 static void bilinear_row(const float* near, const float* far, int w, const Channels& channels,
                          int c, float* dst) {
   for (int x = 0; x < w; ++x, dst += 2 * c) {
     const int64_t left = std::max(x - 1, 0) * static_cast<int64_t>(c);
     const int64_t centre = static_cast<int64_t>(x) * c;
     const int64_t right = std::min(x + 1, w - 1) * static_cast<int64_t>(c);
-    channels.each([&](int j, auto v) {
+    channels.each([&](int j, auto lane) {
+      const auto three_quarters = lane.splat(0.75f), quarter = lane.splat(0.25f);
       auto column = [&](int64_t at) {
-        return vfmaq_n_f32(vmulq_n_f32(v.load(far + at + j), 0.25f), v.load(near + at + j), 0.75f);
+        return fmadd(lane.load(near + at + j), three_quarters, times(lane.load(far + at + j), quarter));
       };
-      const float32x4_t mid = vmulq_n_f32(column(centre), 0.75f);
-      v.store(dst + j, vfmaq_n_f32(mid, column(left), 0.25f));
-      v.store(dst + c + j, vfmaq_n_f32(mid, column(right), 0.25f));
+      const auto mid = times(column(centre), three_quarters);
+      lane.store(dst + j, fmadd(column(left), quarter, mid));
+      lane.store(dst + c + j, fmadd(column(right), quarter, mid));
     });
   }
 }

@@ -1,5 +1,7 @@
 // Loops over the channels of one NHWC pixel in 16-float vectors, the last one masked.
-// Include only from *_avx512.cpp files. Same pattern as avx2_channels.h.
+// Include only from *_avx512.cpp files. Unlike AVX2 (see avx2_channels.h), the channels
+// left over take one masked vector: AVX-512 masked loads and stores (mask registers, not
+// vmaskmovps) run at the speed of plain ones, so kernel bodies use the intrinsics directly.
 #pragma once
 #include <immintrin.h>
 

@@ -15,7 +15,6 @@ void activate_inplace(float* x, int64_t n, ActivationSpec act);
 void gated_output(const float* in, int64_t pixels, int c, ActivationSpec act, float* out);
 void concat_channels(const float* a, int ca, const float* b, int cb, int64_t pixels, float* out);
 void channel_sum(const float* in, int64_t pixels, int c, float* sum);
-void channel_scale(const float* in, int64_t pixels, int c, const float* scale, float* out);
 void dense(const float* w, const float* bias, int rows, int cols, const float* x,
            ActivationSpec act, float* y);
 void haar_dwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);

@@ -1,4 +1,5 @@
-// AVX-512 kernels along the channel axis: gated output, concat, squeeze-excite parts.
+// AVX-512 kernels along the channel axis: gated output, concat, squeeze-excite parts
+// (channel_scale stays the reference: see kernels/reference/channels.cpp).
 #include "kernels/x86/avx512_channels.h"
 #include "kernels/x86/avx512_kernels.h"
 #include "kernels/x86/avx512_math.h"
@@ -36,14 +37,6 @@ void channel_sum(const float* in, int64_t pixels, int c, float* sum) {
     for (int64_t p = 0; p < pixels; ++p) acc = _mm512_add_ps(acc, v.load(in + p * c + j));
     v.store(sum + j, acc);
   });
-}
-
-void channel_scale(const float* in, int64_t pixels, int c, const float* scale, float* out) {
-  const Channels channels(c);
-  for (int64_t p = 0; p < pixels; ++p)
-    channels.each([&](int j, auto v) {
-      v.store(out + p * c + j, _mm512_mul_ps(v.load(in + p * c + j), v.load(scale + j)));
-    });
 }
 
 void dense(const float* w, const float* bias, int rows, int cols, const float* x,

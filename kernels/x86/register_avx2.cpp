@@ -9,7 +9,6 @@ void fill_avx2_kernels(KernelTable& t) {
   t.gated_output = avx2::gated_output;
   t.concat_channels = avx2::concat_channels;
   t.channel_sum = avx2::channel_sum;
-  t.channel_scale = avx2::channel_scale;
   t.dense = avx2::dense;
   t.haar_dwt = avx2::haar_dwt;
   t.haar_idwt = avx2::haar_idwt;

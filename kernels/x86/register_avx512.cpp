@@ -9,7 +9,6 @@ void fill_avx512_kernels(KernelTable& t) {
   t.gated_output = avx512::gated_output;
   t.concat_channels = avx512::concat_channels;
   t.channel_sum = avx512::channel_sum;
-  t.channel_scale = avx512::channel_scale;
   t.dense = avx512::dense;
   t.haar_dwt = avx512::haar_dwt;
   t.haar_idwt = avx512::haar_idwt;

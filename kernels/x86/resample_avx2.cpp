@@ -1,5 +1,6 @@
 // AVX2 2x resampling kernels: Haar DWT and inverse, nearest and bilinear upscaling.
-// Bandwidth-bound; the vectors pay by moving 8 channels per load and store.
+// Bandwidth-bound; the vectors pay by moving 8 channels per load and store. Bodies are
+// lane-generic (see avx2_channels.h): leftover channels run as scalar code.
 #include <algorithm>
 
 #include "kernels/x86/avx2_channels.h"
@@ -9,63 +10,60 @@ namespace ampi::avx2 {
 
 void haar_dwt(const float* in, int /*h*/, int w, int c, int row_begin, int row_end, float* out) {
   const Channels channels(c);
-  const __m256 half = _mm256_set1_ps(0.5f);
   const int64_t pixel_pair = 2 * c;
   for (int y = row_begin; y < row_end; ++y) {
     const float* top = in + static_cast<int64_t>(2 * y) * w * c;
     const float* bottom = top + static_cast<int64_t>(w) * c;
     float* dst = out + static_cast<int64_t>(y) * (w / 2) * 4 * c;
     for (int x = 0; x < w / 2; ++x, top += pixel_pair, bottom += pixel_pair, dst += 4 * c)
-      channels.each([&](int j, auto v) {
-        const __m256 x00 = v.load(top + j), x01 = v.load(top + c + j);
-        const __m256 x10 = v.load(bottom + j), x11 = v.load(bottom + c + j);
-        const __m256 top_sum = _mm256_add_ps(x00, x01), top_diff = _mm256_sub_ps(x00, x01);
-        const __m256 bottom_sum = _mm256_add_ps(x10, x11), bottom_diff = _mm256_sub_ps(x10, x11);
-        v.store(dst + j, _mm256_mul_ps(_mm256_add_ps(top_sum, bottom_sum), half));
-        v.store(dst + c + j, _mm256_mul_ps(_mm256_add_ps(top_diff, bottom_diff), half));
-        v.store(dst + 2 * c + j, _mm256_mul_ps(_mm256_sub_ps(top_sum, bottom_sum), half));
-        v.store(dst + 3 * c + j, _mm256_mul_ps(_mm256_sub_ps(top_diff, bottom_diff), half));
+      channels.each([&](int j, auto lane) {
+        const auto half = lane.splat(0.5f);
+        const auto x00 = lane.load(top + j), x01 = lane.load(top + c + j);
+        const auto x10 = lane.load(bottom + j), x11 = lane.load(bottom + c + j);
+        const auto top_sum = plus(x00, x01), top_diff = minus(x00, x01);
+        const auto bottom_sum = plus(x10, x11), bottom_diff = minus(x10, x11);
+        lane.store(dst + j, times(plus(top_sum, bottom_sum), half));
+        lane.store(dst + c + j, times(plus(top_diff, bottom_diff), half));
+        lane.store(dst + 2 * c + j, times(minus(top_sum, bottom_sum), half));
+        lane.store(dst + 3 * c + j, times(minus(top_diff, bottom_diff), half));
       });
   }
 }
 
 void haar_idwt(const float* in, int /*h*/, int w, int c, int row_begin, int row_end, float* out) {
   const Channels channels(c);
-  const __m256 half = _mm256_set1_ps(0.5f);
   for (int y = row_begin; y < row_end; ++y) {
     const float* src = in + static_cast<int64_t>(y) * w * 4 * c;
     float* top = out + static_cast<int64_t>(2 * y) * 2 * w * c;
     float* bottom = top + static_cast<int64_t>(2 * w) * c;
     for (int x = 0; x < w; ++x, src += 4 * c, top += 2 * c, bottom += 2 * c)
-      channels.each([&](int j, auto v) {
-        const __m256 ll = v.load(src + j), lh = v.load(src + c + j);
-        const __m256 hl = v.load(src + 2 * c + j), hh = v.load(src + 3 * c + j);
+      channels.each([&](int j, auto lane) {
+        const auto half = lane.splat(0.5f);
+        const auto ll = lane.load(src + j), lh = lane.load(src + c + j);
+        const auto hl = lane.load(src + 2 * c + j), hh = lane.load(src + 3 * c + j);
         // x00 = (s + t) / 2, x01 = (s - t) / 2 with s = LL + HL, t = LH + HH; the bottom
         // row likewise with the differences.
-        const __m256 s = _mm256_add_ps(ll, hl), t = _mm256_add_ps(lh, hh);
-        const __m256 sd = _mm256_sub_ps(ll, hl), td = _mm256_sub_ps(lh, hh);
-        v.store(top + j, _mm256_mul_ps(_mm256_add_ps(s, t), half));
-        v.store(top + c + j, _mm256_mul_ps(_mm256_sub_ps(s, t), half));
-        v.store(bottom + j, _mm256_mul_ps(_mm256_add_ps(sd, td), half));
-        v.store(bottom + c + j, _mm256_mul_ps(_mm256_sub_ps(sd, td), half));
+        const auto s = plus(ll, hl), t = plus(lh, hh);
+        const auto sd = minus(ll, hl), td = minus(lh, hh);
+        lane.store(top + j, times(plus(s, t), half));
+        lane.store(top + c + j, times(minus(s, t), half));
+        lane.store(bottom + j, times(plus(sd, td), half));
+        lane.store(bottom + c + j, times(minus(sd, td), half));
       });
   }
 }
 
 void resize2x_nearest(const float* in, int /*h*/, int w, int c, int row_begin, int row_end, float* out) {
-  const Channels channels(c);
+  const int64_t out_row = 2 * static_cast<int64_t>(w) * c;
   for (int y = row_begin; y < row_end; ++y) {
     const float* src = in + static_cast<int64_t>(y) * w * c;
-    float* top = out + static_cast<int64_t>(2 * y) * 2 * w * c;
-    float* bottom = top + static_cast<int64_t>(2 * w) * c;
-    for (int x = 0; x < w; ++x, src += c, top += 2 * c, bottom += 2 * c)
-      channels.each([&](int j, auto v) {
-        const __m256 value = v.load(src + j);
-        v.store(top + j, value);
-        v.store(top + c + j, value);
-        v.store(bottom + j, value);
-        v.store(bottom + c + j, value);
-      });
+    float* top = out + 2 * y * out_row;
+    float* dst = top;
+    for (int x = 0; x < w; ++x, src += c, dst += 2 * c) {
+      copy_floats(src, c, dst);
+      copy_floats(src, c, dst + c);
+    }
+    copy_floats(top, out_row, top + out_row);  // the second output row repeats the first
   }
 }
 
@@ -75,19 +73,18 @@ void resize2x_nearest(const float* in, int /*h*/, int w, int c, int row_begin, i
 // same blend horizontally.
 static void bilinear_row(const float* near, const float* far, int w, const Channels& channels,
                          int c, float* dst) {
-  const __m256 three_quarters = _mm256_set1_ps(0.75f), quarter = _mm256_set1_ps(0.25f);
   for (int x = 0; x < w; ++x, dst += 2 * c) {
     const int64_t left = std::max(x - 1, 0) * static_cast<int64_t>(c);
     const int64_t centre = static_cast<int64_t>(x) * c;
     const int64_t right = std::min(x + 1, w - 1) * static_cast<int64_t>(c);
-    channels.each([&](int j, auto v) {
+    channels.each([&](int j, auto lane) {
+      const auto three_quarters = lane.splat(0.75f), quarter = lane.splat(0.25f);
       auto column = [&](int64_t at) {
-        return _mm256_fmadd_ps(v.load(near + at + j), three_quarters,
-                               _mm256_mul_ps(v.load(far + at + j), quarter));
+        return fmadd(lane.load(near + at + j), three_quarters, times(lane.load(far + at + j), quarter));
       };
-      const __m256 mid = _mm256_mul_ps(column(centre), three_quarters);
-      v.store(dst + j, _mm256_fmadd_ps(column(left), quarter, mid));
-      v.store(dst + c + j, _mm256_fmadd_ps(column(right), quarter, mid));
+      const auto mid = times(column(centre), three_quarters);
+      lane.store(dst + j, fmadd(column(left), quarter, mid));
+      lane.store(dst + c + j, fmadd(column(right), quarter, mid));
     });
   }
 }
