@@ -21,6 +21,9 @@ void add(const float* a, const float* b, int64_t n, float* out, ActivationSpec a
 void activate(float* x, int64_t n, ActivationSpec act, ThreadPool& pool = default_pool(),
               const KernelTable& k = kernels());
 
+// The ops below are batch-1 NHWC like the rest; their outputs must not overlap their
+// inputs unless a comment says otherwise, and bad sizes throw std::runtime_error.
+
 // Gated convolution output (Yu et al. 2019): in is [pixels][2c], the first c channels the
 // feature, the last c the gate: out[p][j] = act(feature) * sigmoid(gate).
 void gated_output(const float* in, int64_t pixels, int c, ActivationSpec feature_act, float* out,
