@@ -4,4 +4,8 @@
 
 namespace ampi::bench {
 
+// ampi bench render [--frames N] [--naive-frames N] [--size WxH] [--planes N] [--out FILE]:
+// the tiled compositor against the naive one, 2 threads and 1 (render_bench.cpp).
+int render_benchmark(int argc, char** argv);
+
 }  // namespace ampi::bench

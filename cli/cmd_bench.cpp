@@ -16,6 +16,7 @@ struct Benchmark {
 };
 
 const Benchmark kBenchmarks[] = {
+    {"render", bench::render_benchmark, "MPI renderer frames/s vs the naive compositor (1024x768, 8 planes)"},
     {nullptr, nullptr, nullptr},  // helpers add entries above this line
 };
 

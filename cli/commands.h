@@ -8,5 +8,6 @@ int cmd_info(int argc, char** argv);
 int cmd_bench(int argc, char** argv);
 int cmd_slice(int argc, char** argv);
 int cmd_depth(int argc, char** argv);
+int cmd_render(int argc, char** argv);
 
 }  // namespace ampi::cli

@@ -20,6 +20,7 @@ const Command kCommands[] = {
     {"bench", ampi::cli::cmd_bench, "kernel, network, renderer and pipeline latency"},
     {"slice", ampi::cli::cmd_slice, "cut a depth map into planes (adaptive or uniform), print JSON"},
     {"depth", ampi::cli::cmd_depth, "estimate a photo's disparity, write a 16-bit PNG"},
+    {"render", ampi::cli::cmd_render, "new views of a saved MPI: frame, video, GIF, stereo, viewer"},
 };
 
 void print_usage(FILE* out) {
