@@ -1,0 +1,267 @@
+"""Trains the inpainting generator (training/inpaint_model.py) on margins removed from
+sliced photos (training/inpaint_data.py), with the paper's loss
+
+    L_G = L_data + 0.1 L_grad + 0.01 L_disc + 0.01 L_perc
+
+  L_data  mean |y^ - y| over the removed pixels (RGB in [-1, 1])
+  L_grad  sum over scales s = 0..3 of mean |grad_x d_s| + |grad_y d_s|, d = (y^ - y) on
+          the removed pixels, 0 elsewhere, d_s its 2^s average pooling (the depth loss of
+          training/losses.py applied to RGB), divided by the removed fraction so it is a
+          mean over the removed pixels like L_data
+  L_disc  the generator's hinge term -mean D(composite) against the patch discriminator
+  L_perc  mean |phi(composite) - phi(original)| over the first two encoder stages of
+          our depth network, frozen: no pretrained VGG exists here (DESIGN.md), so the
+          features of our own trained network stand in for it. Until a depth checkpoint is
+          given (--perceptual), the encoder keeps its seeded random initialisation:
+          random convolutional features still measure local structure, and the choice is
+          recorded in the checkpoint and the log.
+
+The discriminator minimises the hinge loss mean relu(1 - D(real)) + mean relu(1 + D(fake)).
+Adam with lr 2e-4 (G) and 1e-4 (D) as in the paper; betas (0.5, 0.999), the usual choice
+for GAN training (the paper does not give them).
+
+Resumable: RUN_DIR/last.pt holds both networks, both optimisers, the step and the random
+states, written atomically every --checkpoint-every steps; RUN_DIR/best.pt the generator with
+the best validation PSNR. RUN_DIR/log.csv has one row per logged step.
+
+    nice -n 10 /usr/bin/python3 training/train_inpaint.py --run-dir training/runs/inpaint
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import math
+import os
+import sys
+import time
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import depth_model  # noqa: E402
+import inpaint_data as data  # noqa: E402
+from inpaint_model import InpaintGenerator, PatchDiscriminator  # noqa: E402
+from losses import gradient_loss  # noqa: E402
+
+W_GRAD, W_DISC, W_PERC = 0.1, 0.01, 0.01
+LR_G, LR_D, BETAS = 2e-4, 1e-4, (0.5, 0.999)
+PERCEPTUAL_STAGES = 2  # 1/2 and 1/4 resolution: the third stage would double the step time
+PERCEPTUAL_SEED = 1234
+VALIDATION_SAMPLES, VALIDATION_SEED = 96, 0
+
+
+class PerceptualFeatures(torch.nn.Module):
+    """The first encoder stages of our depth network, frozen (eval mode, no gradients to
+    its weights; gradients do flow to its input)."""
+
+    def __init__(self, checkpoint: str | None):
+        super().__init__()
+        torch.manual_seed(PERCEPTUAL_SEED)
+        net = depth_model.build("lite")
+        self.source = "random-init(seed=%d)" % PERCEPTUAL_SEED
+        if checkpoint:
+            state = torch.load(checkpoint, map_location="cpu")
+            net.load_state_dict(state.get("model", state))
+            self.source = os.path.abspath(checkpoint)
+        self.register_buffer("mean", net.mean.clone())
+        self.register_buffer("std", net.std.clone())
+        self.stages = torch.nn.ModuleList(net.enc[:PERCEPTUAL_STAGES])
+        self.eval()
+        for p in self.parameters():
+            p.requires_grad_(False)
+
+    def train(self, mode: bool = True):
+        return super().train(False)  # BatchNorm stays on its running statistics
+
+    def forward(self, rgb_pm1: torch.Tensor):
+        x = ((rgb_pm1 + 1) * 0.5 - self.mean) / self.std
+        feats = []
+        for stage in self.stages:
+            x = stage(depth_model.haar_dwt(x))
+            feats.append(x)
+        return feats
+
+
+def masked_mean(x: torch.Tensor, mask: torch.Tensor) -> torch.Tensor:
+    """Mean of x over the pixels where mask is 1 (x has C channels, mask one)."""
+    return (x * mask).sum() / (mask.sum() * x.shape[1]).clamp_min(1.0)
+
+
+def pixel_losses(pred, target, removed):
+    diff = (pred - target) * removed
+    data_term = masked_mean(diff.abs(), removed)
+    grad_term = gradient_loss(diff) / removed.mean().clamp_min(1e-3)
+    return data_term, grad_term
+
+
+def generator_step(g, d, phi, opt_g, rgb, hole, removed):
+    pred = g(rgb, hole)
+    fake = rgb * (1 - removed) + pred * removed
+    l_data, l_grad = pixel_losses(pred, rgb, removed)
+    l_disc = -d(fake, removed).mean()
+    with torch.no_grad():
+        real_features = phi(rgb)
+    l_perc = sum((a - b).abs().mean() for a, b in zip(phi(fake), real_features)) / PERCEPTUAL_STAGES
+    loss = l_data + W_GRAD * l_grad + W_DISC * l_disc + W_PERC * l_perc
+    opt_g.zero_grad(set_to_none=True)
+    loss.backward()
+    opt_g.step()
+    parts = {"loss_g": loss, "data": l_data, "grad": l_grad, "disc": l_disc, "perc": l_perc}
+    return fake.detach(), {k: float(v) for k, v in parts.items()}
+
+
+def discriminator_step(d, opt_d, rgb, fake, removed):
+    loss = F.relu(1 - d(rgb, removed)).mean() + F.relu(1 + d(fake, removed)).mean()
+    opt_d.zero_grad(set_to_none=True)
+    loss.backward()
+    opt_d.step()
+    return float(loss)
+
+
+def psnr(mse: float) -> float:
+    """For RGB in [-1, 1], peak-to-peak 2."""
+    return 10 * math.log10(4.0 / max(mse, 1e-12))
+
+
+@torch.no_grad()
+def validate(g, val_batches):
+    """Mean L1 and PSNR over the removed pixels of the fixed validation samples."""
+    g.eval()
+    l1, se, count = 0.0, 0.0, 0.0
+    for rgb, hole, removed in val_batches:
+        diff = (g(rgb, hole) - rgb) * removed
+        l1 += float(diff.abs().sum())
+        se += float((diff ** 2).sum())
+        count += float(removed.sum()) * 3
+    g.train()
+    return l1 / count, psnr(se / count)
+
+
+def fixed_validation(source: data.SampleSource, batch: int):
+    rng = np.random.default_rng(VALIDATION_SEED)
+    return [source.batch(rng, batch) for _ in range(VALIDATION_SAMPLES // batch)]
+
+
+def save_atomic(obj, path):
+    tmp = path + ".tmp"
+    torch.save(obj, tmp)
+    os.replace(tmp, path)
+
+
+def validation_key(args):
+    """What the fixed validation samples depend on besides the photos."""
+    return {"crop": args.crop, "batch": args.batch, "seed": VALIDATION_SEED}
+
+
+def load_or_init(args, g, d, opt_g, opt_d, log):
+    path = os.path.join(args.run_dir, "last.pt")
+    if not os.path.exists(path):
+        return 0, -math.inf, np.random.default_rng(args.seed)
+    ck = torch.load(path, map_location="cpu")
+    g.load_state_dict(ck["generator"])
+    d.load_state_dict(ck["discriminator"])
+    opt_g.load_state_dict(ck["opt_g"])
+    opt_d.load_state_dict(ck["opt_d"])
+    torch.set_rng_state(ck["torch_rng"])
+    rng = np.random.default_rng()
+    rng.bit_generator.state = ck["numpy_rng"]
+    log(f"resumed from {path} at step {ck['step']}")
+    best = ck["best_psnr"]
+    if ck.get("validation") != validation_key(args):
+        log("the validation samples changed (crop or batch): the best PSNR starts over")
+        best = -math.inf
+    return ck["step"], best, rng
+
+
+def checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi):
+    save_atomic({"step": step, "best_psnr": best, "generator": g.state_dict(),
+                 "discriminator": d.state_dict(), "opt_g": opt_g.state_dict(),
+                 "opt_d": opt_d.state_dict(), "torch_rng": torch.get_rng_state(),
+                 "numpy_rng": rng.bit_generator.state, "perceptual": phi.source,
+                 "validation": validation_key(args)},
+                os.path.join(args.run_dir, "last.pt"))
+
+
+def parse_args(argv):
+    ap = argparse.ArgumentParser(description="train the MPI inpainting generator")
+    ap.add_argument("--photos", default=data.DEFAULT_PHOTOS)
+    ap.add_argument("--disparity-dir", default=data.DEFAULT_DISPARITY_DIR)
+    ap.add_argument("--run-dir", default=os.path.join(os.path.dirname(__file__), "runs", "inpaint"))
+    ap.add_argument("--perceptual", default=None, help="depth network checkpoint for L_perc")
+    ap.add_argument("--steps", type=int, default=1_000_000, help="stop after this many steps")
+    ap.add_argument("--batch", type=int, default=6)
+    ap.add_argument("--crop", type=int, default=128)
+    ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--log-every", type=int, default=25)
+    ap.add_argument("--validate-every", type=int, default=250)
+    ap.add_argument("--checkpoint-every", type=int, default=100)
+    ap.add_argument("--max-photos", type=int, default=0, help="use only the first N (smoke tests)")
+    return ap.parse_args(argv)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    torch.set_num_threads(args.threads)
+    os.makedirs(args.run_dir, exist_ok=True)
+
+    def log(msg):
+        print(f"[{time.strftime('%H:%M:%S')}] {msg}", flush=True)
+
+    train_rel, val_rel = data.split_photos(data.list_photos(args.photos))
+    if args.max_photos:
+        train_rel, val_rel = train_rel[:args.max_photos], val_rel[:max(1, args.max_photos // 10)]
+    train = data.SampleSource(data.prepare_photos(args.photos, train_rel, args.disparity_dir, log), args.crop)
+    val_batches = fixed_validation(
+        data.SampleSource(data.prepare_photos(args.photos, val_rel, args.disparity_dir, log), args.crop),
+        args.batch)
+
+    torch.manual_seed(args.seed)
+    g, d = InpaintGenerator(), PatchDiscriminator()
+    phi = PerceptualFeatures(args.perceptual)
+    log(f"perceptual features: depth encoder, {phi.source}")
+    opt_g = torch.optim.Adam(g.parameters(), lr=LR_G, betas=BETAS)
+    opt_d = torch.optim.Adam(d.parameters(), lr=LR_D, betas=BETAS)
+    step, best, rng = load_or_init(args, g, d, opt_g, opt_d, log)
+
+    log_path = os.path.join(args.run_dir, "log.csv")
+    fields = ["step", "time", "loss_g", "data", "grad", "disc", "perc", "loss_d", "val_l1", "val_psnr"]
+    new_log = not os.path.exists(log_path)
+    with open(log_path, "a", newline="") as f:
+        writer = csv.DictWriter(f, fieldnames=fields)
+        if new_log:
+            writer.writeheader()
+        running, started = {}, time.time()
+        while step < args.steps:
+            rgb, hole, removed = train.batch(rng, args.batch)
+            fake, parts = generator_step(g, d, phi, opt_g, rgb, hole, removed)
+            parts["loss_d"] = discriminator_step(d, opt_d, rgb, fake, removed)
+            step += 1
+            for k, v in parts.items():
+                running[k] = running.get(k, 0.0) + v
+            row = None
+            if step % args.log_every == 0:
+                row = {k: running[k] / args.log_every for k in running}
+                running = {}
+            if step % args.validate_every == 0:
+                row = row or {}
+                row["val_l1"], row["val_psnr"] = validate(g, val_batches)
+                if row["val_psnr"] > best:
+                    best = row["val_psnr"]
+                    save_atomic({"step": step, "val_psnr": best, "generator": g.state_dict()},
+                                os.path.join(args.run_dir, "best.pt"))
+            if row is not None:
+                row.update(step=step, time=round(time.time() - started, 1))
+                writer.writerow({k: (f"{v:.5f}" if isinstance(v, float) else v) for k, v in row.items()})
+                f.flush()
+                log(" ".join(f"{k}={v:.4f}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
+            if step % args.checkpoint_every == 0:
+                checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi)
+    checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
