@@ -136,6 +136,19 @@ void composite_group(const PlaneView& plane, const Footprints& f, int n, float* 
   }
 }
 
+// Bilinear samples of pixels p and p + 1 of a translated row: `top` points at the left
+// footprint pixel of p, whose right neighbour is the left one of p + 1, so two unaligned
+// loads per row give [left | right] of both pixels.
+__m256 shifted_pair(const uint16_t* top, int64_t below, __m256 ax, __m256 ay) {
+  const __m256 tl = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(top)));
+  const __m256 tr = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(top + 4)));
+  const __m256 bl = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(top + below)));
+  const __m256 br = _mm256_cvtph_ps(_mm_loadu_si128(reinterpret_cast<const __m128i*>(top + below + 4)));
+  const __m256 t = _mm256_fmadd_ps(ax, _mm256_sub_ps(tr, tl), tl);
+  const __m256 bo = _mm256_fmadd_ps(ax, _mm256_sub_ps(br, bl), bl);
+  return _mm256_fmadd_ps(ay, _mm256_sub_ps(bo, t), t);
+}
+
 __m128i round_to_bytes(__m128 a, __m128 b, __m128 c, __m128 d) {
   const __m128 scale = _mm_set1_ps(255.0f);
   const __m128i ab = _mm_packs_epi32(_mm_cvtps_epi32(_mm_mul_ps(a, scale)),
@@ -154,6 +167,20 @@ void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, in
     const Footprints f = locate(r, x_begin + i);
     composite_group(plane, f, count - i < 8 ? count - i : 8, accum + 4 * i);
   }
+}
+
+void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,
+                    float* accum) {
+  const ShiftSpan span = shift_span(plane, du, dv, y, x_begin, count);
+  if (span.empty) return;
+  const int64_t below = 4 * plane.stride;
+  const uint16_t* row = plane.origin + span.row * below + 4 * static_cast<int64_t>(span.column_offset);
+  const __m256 ax = _mm256_set1_ps(span.ax), ay = _mm256_set1_ps(span.ay);
+  int x = span.first;
+  for (; x + 1 <= span.last; x += 2)
+    over_pair(accum + 4 * (x - x_begin), shifted_pair(row + 4 * static_cast<int64_t>(x), below, ax, ay));
+  if (x == span.last)
+    over_one(accum + 4 * (x - x_begin), sample_one(plane, static_cast<int32_t>(span.row * plane.stride + x + span.column_offset), span.ax, span.ay));
 }
 
 void accum_to_bgr(const float* accum, int count, uint8_t* bgr) {

@@ -1,9 +1,31 @@
 #include "render/composite_kernels.h"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
 namespace ampi::render {
+
+ShiftSpan shift_span(const PlaneView& plane, float du, float dv, int y, int x_begin, int count) {
+  ShiftSpan span;
+  // v as the general warp computes it; outside [-1, height] it reads only the border.
+  const float v = static_cast<float>(y) + dv;
+  if (!(v >= -1.0f && v <= static_cast<float>(plane.height)) || !std::isfinite(du)) return span;
+  const float fv = std::floor(v), fu = std::floor(du);
+  // Pixel x's footprint starts at column x + fu: it must lie in [-1, width].
+  const double first = std::max<double>(x_begin, -1.0 - fu);
+  const double last = std::min<double>(x_begin + count - 1.0, plane.width - static_cast<double>(fu));
+  if (first > last) return span;
+  span.empty = false;
+  span.first = static_cast<int>(first);
+  span.last = static_cast<int>(last);
+  span.column_offset = static_cast<int>(fu);  // within [-1 - last, width - first]: no overflow
+  span.row = static_cast<int>(fv);
+  span.ax = du - fu;
+  span.ay = v - fv;
+  return span;
+}
 
 CompositeKernels composite_kernels(Isa isa) {
   if (!isa_runnable(isa))
@@ -13,12 +35,12 @@ CompositeKernels composite_kernels(Isa isa) {
 #if defined(__x86_64__)
     case Isa::Avx2:
     case Isa::Avx512:  // no wider variant: AVX-512 CPUs run the AVX2 one
-      return {isa, avx2::warp_over_row, avx2::accum_to_bgr};
+      return {isa, avx2::warp_over_row, avx2::shift_over_row, avx2::accum_to_bgr};
 #endif
 #if defined(__aarch64__)
-    case Isa::Neon: return {isa, neon::warp_over_row, neon::accum_to_bgr};
+    case Isa::Neon: return {isa, neon::warp_over_row, neon::shift_over_row, neon::accum_to_bgr};
 #endif
-    default: return {Isa::Scalar, scalar::warp_over_row, scalar::accum_to_bgr};
+    default: return {Isa::Scalar, scalar::warp_over_row, scalar::shift_over_row, scalar::accum_to_bgr};
   }
 }
 

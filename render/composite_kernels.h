@@ -35,6 +35,24 @@ constexpr float kMinHomogeneousW = 1e-6f;
 // pixel, BGRA premultiplied): accum = sample + accum * (1 - sample.alpha).
 using WarpOverRowFn = void (*)(const PlaneView& plane, const InverseHomography& h, int y,
                                int x_begin, int count, float* accum);
+// The same for a map that only translates: the layer is sampled at (x + du, y + dv).
+// Most camera paths (circle, swing) and the viewer move the camera parallel to the image,
+// which makes every plane's map a translation; then the bilinear weights are the same
+// for a whole row and neighbouring pixels read neighbouring memory.
+using ShiftOverRowFn = void (*)(const PlaneView& plane, float du, float dv, int y, int x_begin,
+                                int count, float* accum);
+// Where a translated row reads the layer. Output pixels x in [first, last] read columns
+// x + column_offset and x + column_offset + 1 of rows `row` and `row` + 1 of the padded
+// layer, with the weights ax (right) and ay (below); the row's other pixels read only the
+// transparent border and are left alone. Empty when nothing is read.
+struct ShiftSpan {
+  bool empty = true;
+  int first = 0, last = -1;
+  int column_offset = 0, row = 0;
+  float ax = 0, ay = 0;
+};
+ShiftSpan shift_span(const PlaneView& plane, float du, float dv, int y, int x_begin, int count);
+
 // bgr[3i..3i+2] = round(255 * accum[4i..4i+2]) clamped to [0, 255], for i in [0, count):
 // the composite over a black background.
 using AccumToBgrFn = void (*)(const float* accum, int count, uint8_t* bgr);
@@ -42,6 +60,7 @@ using AccumToBgrFn = void (*)(const float* accum, int count, uint8_t* bgr);
 struct CompositeKernels {
   Isa isa = Isa::Scalar;
   WarpOverRowFn warp_over_row = nullptr;
+  ShiftOverRowFn shift_over_row = nullptr;
   AccumToBgrFn accum_to_bgr = nullptr;
 };
 
@@ -52,6 +71,8 @@ CompositeKernels composite_kernels(Isa isa);
 namespace scalar {
 void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
                    int count, float* accum);
+void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,
+                    float* accum);
 void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
 }  // namespace scalar
 
@@ -59,6 +80,8 @@ void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
 namespace avx2 {
 void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
                    int count, float* accum);
+void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,
+                    float* accum);
 void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
 }  // namespace avx2
 #endif
@@ -67,6 +90,8 @@ void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
 namespace neon {
 void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
                    int count, float* accum);
+void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,
+                    float* accum);
 void accum_to_bgr(const float* accum, int count, uint8_t* bgr);
 }  // namespace neon
 #endif

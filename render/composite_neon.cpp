@@ -98,6 +98,15 @@ void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, in
   }
 }
 
+void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,
+                    float* accum) {
+  const ShiftSpan span = shift_span(plane, du, dv, y, x_begin, count);
+  if (span.empty) return;
+  const int32_t row_start = static_cast<int32_t>(span.row * plane.stride + span.column_offset);
+  for (int x = span.first; x <= span.last; ++x)
+    over(accum + 4 * (x - x_begin), sample(plane, row_start + x, span.ax, span.ay));
+}
+
 void accum_to_bgr(const float* accum, int count, uint8_t* bgr) {
   int i = 0;
   for (; i + 8 <= count; i += 8) {

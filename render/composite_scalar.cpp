@@ -61,6 +61,13 @@ void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, in
   }
 }
 
+// The reference is the general warp with the translation's matrix: with its zeros and
+// ones the warp computes u = x + du and v = y + dv exactly.
+void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,
+                    float* accum) {
+  warp_over_row(plane, InverseHomography{{1, 0, du, 0, 1, dv, 0, 0, 1}}, y, x_begin, count, accum);
+}
+
 void accum_to_bgr(const float* accum, int count, uint8_t* bgr) {
   for (int i = 0; i < count; ++i)
     for (int k = 0; k < 3; ++k) {

@@ -132,6 +132,26 @@ Renderer::Renderer(const Mpi& mpi, RendererOptions options)
     layers_.push_back(prepare_layer(mpi.layers[j], mpi.planes[j].depth));
 }
 
+// Camera moves parallel to the image plane (no rotation, zoom or motion along z) make
+// every plane's map a translation, up to rounding in the matrix products.
+Renderer::PlaneMap Renderer::plane_map(const cv::Matx33d& inverse) {
+  PlaneMap map;
+  map.inverse_d = inverse;
+  map.inverse = to_float(inverse);
+  constexpr double kTolerance = 1e-12;
+  const cv::Matx33d& m = inverse;
+  const bool affine_identity = std::fabs(m(2, 2) - 1) < kTolerance && std::fabs(m(0, 0) - 1) < kTolerance &&
+                               std::fabs(m(1, 1) - 1) < kTolerance && std::fabs(m(0, 1)) < kTolerance &&
+                               std::fabs(m(1, 0)) < kTolerance && std::fabs(m(2, 0)) < kTolerance &&
+                               std::fabs(m(2, 1)) < kTolerance;
+  if (affine_identity) {
+    map.translation = true;
+    map.du = static_cast<float>(m(0, 2));
+    map.dv = static_cast<float>(m(1, 2));
+  }
+  return map;
+}
+
 // The tile's corners are mapped into the layer; when all lie in front of the camera, the
 // image of the tile is inside their bounding box, and the pixels the bilinear footprints
 // read inside that box grown by one pixel. The box is widened by a small margin because
@@ -177,9 +197,14 @@ void Renderer::render_tile(const std::vector<PlaneMap>& maps, const cv::Rect& ti
   std::fill(accum, accum + row_floats * tile.height, 0.0f);
   for (int j = first; j < planes; ++j) {
     if (covers[j] == TileCover::None) continue;
-    for (int r = 0; r < tile.height; ++r)
-      kernels_.warp_over_row(layers_[j].view, maps[j].inverse, tile.y + r, tile.x, tile.width,
-                             accum + r * row_floats);
+    const PlaneMap& map = maps[j];
+    for (int r = 0; r < tile.height; ++r) {
+      float* row = accum + r * row_floats;
+      if (map.translation)
+        kernels_.shift_over_row(layers_[j].view, map.du, map.dv, tile.y + r, tile.x, tile.width, row);
+      else
+        kernels_.warp_over_row(layers_[j].view, map.inverse, tile.y + r, tile.x, tile.width, row);
+    }
   }
   for (int r = 0; r < tile.height; ++r)
     kernels_.accum_to_bgr(accum + r * row_floats, tile.width, out.ptr<uint8_t>(tile.y + r) + 3 * tile.x);
@@ -193,11 +218,8 @@ cv::Mat Renderer::render(const Pose& pose, ThreadPool& pool) const {
 
 void Renderer::render(const Pose& pose, cv::Mat& out, ThreadPool& pool) const {
   out.create(camera_.height, camera_.width, CV_8UC3);
-  std::vector<PlaneMap> maps(layers_.size());
-  for (size_t j = 0; j < layers_.size(); ++j) {
-    maps[j].inverse_d = plane_homography(camera_, pose, layers_[j].depth).inv();
-    maps[j].inverse = to_float(maps[j].inverse_d);
-  }
+  std::vector<PlaneMap> maps;
+  for (const Layer& layer : layers_) maps.push_back(plane_map(plane_homography(camera_, pose, layer.depth).inv()));
   const int tw = options_.tile_width, th = options_.tile_height;
   const int tiles_x = (camera_.width + tw - 1) / tw, tiles_y = (camera_.height + th - 1) / th;
   pool.parallel_for(int64_t{tiles_x} * tiles_y, 1, [&](int64_t begin, int64_t end) {

@@ -61,7 +61,10 @@ class Renderer {
   struct PlaneMap {
     render::InverseHomography inverse;
     cv::Matx33d inverse_d;
+    bool translation = false;  // inverse is (x, y) -> (x + du, y + dv)
+    float du = 0, dv = 0;
   };
+  static PlaneMap plane_map(const cv::Matx33d& inverse);
   // What a tile of the new view receives from a plane: nothing (skip it), some pixels,
   // or opaque pixels only (the planes behind it are hidden there).
   enum class TileCover { None, Partial, Opaque };

@@ -147,6 +147,43 @@ TEST_CASE("every compositor kernel matches the scalar reference") {
   }
 }
 
+TEST_CASE("every translation kernel matches the scalar reference") {
+  // Shifts that put the row inside, across each edge and entirely outside the layer.
+  const int width = 37, height = 19;
+  const uint32_t seed = 13;
+  INFO("seed " << seed);
+  std::vector<uint16_t> padded(static_cast<size_t>(4) * (width + 3) * (height + 3), 0);
+  const auto values = test::random_floats(padded.size(), seed, 0.0f, 1.0f);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      for (int k = 0; k < 4; ++k) {
+        const size_t at = 4 * ((y + 1) * (width + 3) + x + 1) + k;
+        padded[at] = float_to_half(k == 3 ? values[at - k + 3] : values[at] * values[at - k + 3]);
+      }
+  const render::PlaneView plane{padded.data() + 4 * (width + 3 + 1), width + 3, width, height};
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<float> shift(-45.0f, 45.0f);
+  const render::CompositeKernels reference = render::composite_kernels(Isa::Scalar);
+  for (Isa isa : runnable_isas()) {
+    const render::CompositeKernels k = render::composite_kernels(isa);
+    for (int trial = 0; trial < 60; ++trial) {
+      const float du = trial < 4 ? std::vector<float>{0.0f, -1.0f, 1e9f, -1e9f}[trial] : shift(rng);
+      const float dv = trial % 7 == 0 ? std::floor(shift(rng)) : shift(rng) / 2;
+      for (int count : {1, 2, 3, 5, 8, 9, 16, 31, 64}) {
+        const int x_begin = trial % 11 - 5, y = trial % (height + 4) - 2;
+        INFO("isa " << isa_name(isa) << ", du " << du << ", dv " << dv << ", y " << y << ", x " << x_begin
+                    << ", count " << count);
+        const auto start = test::random_floats(4 * count, seed + trial, 0.0f, 1.0f);
+        std::vector<float> expected = start, got = start;
+        reference.shift_over_row(plane, du, dv, y, x_begin, count, expected.data());
+        k.shift_over_row(plane, du, dv, y, x_begin, count, got.data());
+        // The reference rounds x + du for every pixel, the kernels split du once.
+        CHECK(test::max_abs_diff(expected.data(), got.data(), expected.size()) <= 1e-4f);
+      }
+    }
+  }
+}
+
 TEST_CASE("accumulators outside [0, 1] saturate to black and white") {
   const std::vector<float> accum = {-0.5f, 1.5f, 0.5f, 1.0f, 2.0f, -3.0f, 1.0f, 0.0f};
   for (Isa isa : runnable_isas()) {
