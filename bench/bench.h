@@ -4,8 +4,16 @@
 
 namespace ampi::bench {
 
+// ampi bench kernels [--threads N] [--runs N] [--out FILE]: convolution kernels of every
+// runnable ISA against the machine's FMA peak and memory bandwidth (kernels_bench.cpp).
+int kernels_benchmark(int argc, char** argv);
+
 // ampi bench render [--frames N] [--naive-frames N] [--size WxH] [--planes N] [--out FILE]:
 // the tiled compositor against the naive one, 2 threads and 1 (render_bench.cpp).
 int render_benchmark(int argc, char** argv);
+
+// ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N] [--out FILE]:
+// per-stage times of `ampi run` and peak memory at 1024x768 and 4K (pipeline_bench.cpp).
+int pipeline_benchmark(int argc, char** argv);
 
 }  // namespace ampi::bench

@@ -16,7 +16,9 @@ struct Benchmark {
 };
 
 const Benchmark kBenchmarks[] = {
+    {"kernels", bench::kernels_benchmark, "convolution kernels vs the machine's FMA peak and memory bandwidth"},
     {"render", bench::render_benchmark, "MPI renderer frames/s vs the naive compositor (1024x768, 8 planes)"},
+    {"pipeline", bench::pipeline_benchmark, "ampi run stage by stage, peak memory (1024x768 and 4K)"},
     {nullptr, nullptr, nullptr},  // helpers add entries above this line
 };
 

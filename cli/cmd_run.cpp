@@ -3,6 +3,7 @@
 #include <cctype>
 #include <cstdio>
 #include <filesystem>
+#include <new>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -49,6 +50,7 @@ const char kUsage[] =
     "  --uniform               equal disparity intervals (the paper's baseline)\n"
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
     "  --inpaint-weights FILE  inpainting network weight file instead of the bundled one\n"
+    "  --classic-inpainting    fill occluded margins by push-pull instead of the network\n"
     "  --fov DEG               assumed horizontal field of view (default 60)\n"
     "  --trajectory NAME       circle, swing, zoom-in or dolly-zoom (default circle)\n"
     "  --keyframes FILE        a JSON keyframe file instead of --trajectory\n"
@@ -94,6 +96,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.flag("--uniform", &a.mpi.uniform);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
+  p.flag("--classic-inpainting", &a.mpi.classic_inpainting);
   p.option("--fov", &a.mpi.fov_degrees, 1, 179);
   PathOptions& path = a.video_options.path;
   p.option("--trajectory", [&](const std::string& v) { path.kind = parse_path_kind(v); });
@@ -187,6 +190,10 @@ int cmd_run(int argc, char** argv) {
     if (!one) progress.note(photo);
     try {
       run_one(maker, a, photo, destination, progress);
+    } catch (const std::bad_alloc&) {
+      std::fprintf(stderr, "ampi run: %s: out of memory (less was free than the memory budget, AMPI_MEMORY_BUDGET, allowed)\n",
+                   photo.c_str());
+      ++failed;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ampi run: %s\n", e.what());
       ++failed;

@@ -4,6 +4,7 @@
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 
+#include "engine/memory_budget.h"
 #include "inpaint/inpaint_net.h"
 #include "nets/weights_path.h"
 #include "pipeline/depth_estimate.h"
@@ -68,7 +69,7 @@ LayerFiller& MpiMaker::filler() {
   if (filler_) return *filler_;
   const std::string path =
       options_.inpaint_weights.empty() ? bundled_inpaint_weights() : options_.inpaint_weights;
-  if (path.empty()) {
+  if (path.empty() || options_.classic_inpainting) {
     filler_ = push_pull_filler();
     inpainter_ = "push-pull";
   } else {
@@ -79,6 +80,12 @@ LayerFiller& MpiMaker::filler() {
 }
 
 MpiResult MpiMaker::make(const cv::Mat& bgr, const std::string& photo_path, Progress& progress) {
+  // The layers are the run's largest buffers: a photo they would not fit in memory is
+  // refused before any work is done.
+  const int layers = options_.slicing.max_planes;
+  check_allocation(bytes_for({uint64_t(layers), uint64_t(bgr.cols), uint64_t(bgr.rows), 4}), photo_path,
+                   std::to_string(layers) + " RGBA layers at " + std::to_string(bgr.cols) + "x" +
+                       std::to_string(bgr.rows));
   MpiResult result;
   const cv::Mat disparity = working_disparity(bgr, photo_path, progress);
   // Slice at the working resolution (the histogram needs no more pixels), cut the

@@ -74,3 +74,28 @@ TEST_CASE("push-pull reproduces known pixels and interpolates holes smoothly") {
   CHECK(cv::mean(diff, hole)[2] < 3);
   CHECK(cv::norm(diff, cv::NORM_INF, hole) < 48);
 }
+
+TEST_CASE("occlusion masks equal the paper's iterated 3x3 dilation on random layers") {
+  cv::RNG rng(1234);
+  for (int iterations : {1, 3, 7, 12}) {
+    std::vector<cv::Mat> layers;
+    for (int j = 0; j < 3; ++j) {
+      cv::Mat layer(50, 70, CV_8UC4, cv::Scalar(0, 0, 0, 0));
+      for (int blob = 0; blob < 4; ++blob)
+        cv::circle(layer, {rng.uniform(0, 70), rng.uniform(0, 50)}, rng.uniform(2, 12),
+                   cv::Scalar(1, 2, 3, 255), cv::FILLED);
+      layers.push_back(layer);
+    }
+    const auto masks = occlusion_masks(layers, {iterations});
+    cv::Mat nearer(50, 70, CV_8UC1, cv::Scalar(0));
+    for (int j = 2; j >= 0; --j) {
+      cv::Mat coverage, grown;
+      cv::extractChannel(layers[j], coverage, 3);
+      cv::dilate(coverage, grown, cv::Mat::ones(3, 3, CV_8U), {-1, -1}, iterations);
+      const cv::Mat expected = grown & ~coverage & nearer;
+      INFO("iterations " << iterations << ", layer " << j);
+      CHECK(cv::countNonZero(expected != masks[j]) == 0);
+      nearer |= coverage;
+    }
+  }
+}

@@ -1,0 +1,187 @@
+// ampi bench pipeline: where the time of `ampi run` goes, stage by stage, and the peak
+// memory, at 1024x768 and at 4K, on the bundled example photo resized to each size.
+#include <sys/resource.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "bench/bench.h"
+#include "cli/args.h"
+#include "engine/thread_pool.h"
+#include "mpi/mpi_io.h"
+#include "nets/weights_path.h"
+#include "pipeline/make_mpi.h"
+#include "pipeline/photo_io.h"
+#include "pipeline/video.h"
+
+namespace fs = std::filesystem;
+
+namespace ampi::bench {
+namespace {
+
+const char kUsage[] =
+    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N] [--out FILE]\n"
+    "\n"
+    "Times every stage of `ampi run` (decode, depth, slicing, assembly, inpainting, MPI\n"
+    "write, render + encode of the video) on PHOTO resized to 1024x768 and to 3840x2160,\n"
+    "medians of N runs, and the process's peak resident memory after each size. Writes the\n"
+    "table to bench/RESULTS-pipeline.md.\n"
+    "\n"
+    "  --photo FILE   default examples/forest_path.jpg\n"
+    "  --runs N       runs per size (default 3)\n"
+    "  --threads N    worker threads (default 2)\n"
+    "  --frames N     video frames rendered and encoded per run (default 30)\n"
+    "  --classic-inpainting  push-pull instead of the inpainting network\n"
+    "  --out FILE     default bench/RESULTS-pipeline.md\n";
+
+double peak_rss_mb() {
+  struct rusage usage;
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes
+}
+
+double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
+
+struct SizeResult {
+  cv::Size size;
+  std::vector<std::string> stages;             // in pipeline order
+  std::map<std::string, std::vector<double>> ms;  // per stage, one value per run
+  double peak_mb = 0;
+  size_t planes = 0;
+};
+
+// One `ampi run` worth of work on `photo_file`, timed by stage into `progress`.
+size_t run_once(MpiMaker& maker, const std::string& photo_file, const fs::path& scratch,
+                const VideoOptions& video, Progress& progress) {
+  const cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo_file); });
+  const MpiResult result = maker.make(bgr, photo_file, progress);
+  fs::remove_all(scratch / "mpi");
+  fs::remove_all(scratch / "video.mp4");
+  progress.stage("write mpi", [&] { write_mpi(result.mpi, (scratch / "mpi").string()); });
+  progress.stage("render+encode", [&] {
+    return write_video(result.mpi, video, (scratch / "video.mp4").string(), false);
+  });
+  return result.mpi.planes.size();
+}
+
+SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOptions& options,
+                   const VideoOptions& video, const fs::path& scratch) {
+  SizeResult r;
+  r.size = size;
+  cv::Mat resized;
+  cv::resize(source, resized, size, 0, 0, size.width < source.cols ? cv::INTER_AREA : cv::INTER_CUBIC);
+  const std::string photo_file = (scratch / "photo.jpg").string();
+  if (!cv::imwrite(photo_file, resized, {cv::IMWRITE_JPEG_QUALITY, 92}))
+    throw std::runtime_error(photo_file + ": cannot write the benchmark photo");
+  MpiMaker maker{options};
+  for (int k = 0; k <= runs; ++k) {  // run 0 loads the networks and warms the caches
+    Progress progress(true);
+    r.planes = run_once(maker, photo_file, scratch, video, progress);
+    if (k == 0) continue;
+    for (const auto& [stage, ms] : progress.times_ms()) {
+      if (!r.ms.count(stage)) r.stages.push_back(stage);
+      r.ms[stage].push_back(ms);
+    }
+  }
+  r.peak_mb = peak_rss_mb();
+  return r;
+}
+
+std::string table(const std::vector<SizeResult>& results, const MpiOptions& options, int threads,
+                  int frames, int runs) {
+  std::ostringstream md;
+  md << "# Pipeline benchmark\n\n"
+     << "`ampi bench pipeline`: the stages of `ampi run` on the bundled example photo resized\n"
+     << "to each size, " << threads << " threads, median of " << runs << " runs after a warm-up run;\n"
+     << "the video is " << frames << " frames. Peak memory is the process's maximum resident\n"
+     << "set after all runs at that size (sizes run smallest first, so each includes the\n"
+     << "ones before). Inpainting: " << (options.classic_inpainting ? "push-pull" : "the network")
+     << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"
+     << "| stage |";
+  for (const SizeResult& r : results) md << " " << r.size.width << "x" << r.size.height << " (ms) |";
+  md << "\n|---|";
+  for (size_t i = 0; i < results.size(); ++i) md << "---:|";
+  md << "\n";
+  for (const std::string& stage : results.front().stages) {
+    md << "| " << stage << " |";
+    for (const SizeResult& r : results) {
+      char cell[32];
+      std::snprintf(cell, sizeof cell, " %.0f |", median(r.ms.count(stage) ? r.ms.at(stage) : std::vector<double>{}));
+      md << cell;
+    }
+    md << "\n";
+  }
+  const char* to_mpi[] = {"decode", "depth", "slicing", "assembly", "inpainting"};
+  md << "| **photo to MPI** (decode..inpainting) |";
+  for (const SizeResult& r : results) {
+    double sum = 0;
+    for (const char* s : to_mpi) sum += r.ms.count(s) ? median(r.ms.at(s)) : 0;
+    char cell[32];
+    std::snprintf(cell, sizeof cell, " **%.0f** |", sum);
+    md << cell;
+  }
+  md << "\n| planes |";
+  for (const SizeResult& r : results) md << " " << r.planes << " |";
+  md << "\n| peak memory (MB) |";
+  for (const SizeResult& r : results) {
+    char cell[32];
+    std::snprintf(cell, sizeof cell, " %.0f |", r.peak_mb);
+    md << cell;
+  }
+  md << "\n";
+  return md.str();
+}
+
+}  // namespace
+
+int pipeline_benchmark(int argc, char** argv) {
+  std::string photo = "examples/forest_path.jpg", out = "bench/RESULTS-pipeline.md";
+  int runs = 3, threads = 2, frames = 30;
+  MpiOptions options;
+  cli::ArgParser p("bench pipeline", kUsage);
+  p.option("--photo", &photo);
+  p.option("--runs", &runs, 1, 100);
+  p.option("--threads", &threads, 1, 256);
+  p.option("--frames", &frames, 1, 10000);
+  p.option("--out", &out);
+  p.flag("--classic-inpainting", &options.classic_inpainting);
+  if (!p.parse(argc, argv)) return 0;
+  set_default_threads(threads);
+
+  const cv::Mat source = read_photo(photo);
+  VideoOptions video;
+  video.path.frames = frames;
+  const fs::path scratch = fs::temp_directory_path() / ("ampi_bench_pipeline_" + std::to_string(getpid()));
+  fs::create_directories(scratch);
+  std::vector<SizeResult> results;
+  try {
+    for (cv::Size size : {cv::Size(1024, 768), cv::Size(3840, 2160)}) {
+      std::fprintf(stderr, "ampi bench pipeline: %dx%d ...\n", size.width, size.height);
+      results.push_back(measure(source, size, runs, options, video, scratch));
+    }
+  } catch (...) {
+    fs::remove_all(scratch);
+    throw;
+  }
+  fs::remove_all(scratch);
+  const std::string md = table(results, options, threads, frames, runs);
+  std::fputs(md.c_str(), stdout);
+  std::ofstream(out) << md;
+  std::fprintf(stderr, "ampi bench pipeline: wrote %s\n", out.c_str());
+  return 0;
+}
+
+}  // namespace ampi::bench
