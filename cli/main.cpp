@@ -21,6 +21,7 @@ const Command kCommands[] = {
     {"slice", ampi::cli::cmd_slice, "cut a depth map into planes (adaptive or uniform), print JSON"},
     {"depth", ampi::cli::cmd_depth, "estimate a photo's disparity, write a 16-bit PNG"},
     {"render", ampi::cli::cmd_render, "new views of a saved MPI: frame, video, GIF, stereo, viewer"},
+    {"eval", ampi::cli::cmd_eval, "reproduce the paper's evaluations on a folder of photos"},
 };
 
 void print_usage(FILE* out) {
