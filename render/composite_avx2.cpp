@@ -13,8 +13,13 @@
 #if defined(__x86_64__)
 #include <immintrin.h>
 
+// clang has no target pragma; its attribute pragma does the same for every function.
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2,fma,f16c"))), apply_to = function)
+#else
 #pragma GCC push_options
 #pragma GCC target("avx2,fma,f16c")
+#endif
 
 namespace ampi::render::avx2 {
 namespace {
@@ -205,5 +210,9 @@ void accum_to_bgr(const float* accum, int count, uint8_t* bgr) {
 
 }  // namespace ampi::render::avx2
 
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
 #pragma GCC pop_options
+#endif
 #endif  // __x86_64__

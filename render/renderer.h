@@ -33,10 +33,6 @@ class Renderer {
   // its layers; the Renderer does not keep a reference to `mpi`.
   explicit Renderer(const Mpi& mpi, RendererOptions options = {});
 
-  const Camera& camera() const { return camera_; }
-  int plane_count() const { return static_cast<int>(layers_.size()); }
-  double plane_depth(int j) const { return layers_[j].depth; }
-
   // The view from `pose` as 8-bit BGR (the composite over black), camera-sized.
   cv::Mat render(const Pose& pose) const { return render(pose, default_pool()); }
   cv::Mat render(const Pose& pose, ThreadPool& pool) const;
