@@ -81,7 +81,9 @@ DepthNet load_depth(const std::string& path) {
     try {
       file = find_weights("depth_lite.ampw");
     } catch (const std::exception& e) {
-      throw std::runtime_error(std::string("the depth network is needed to slice the photos: ") + e.what());
+      throw std::runtime_error(
+          std::string("the depth network is needed to slice the photos (or give --depth-weights FILE "
+                      "or --depth-dir DIR): ") + e.what());
     }
   }
   const WeightFile info = WeightFile::open(file);

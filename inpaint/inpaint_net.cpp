@@ -298,8 +298,12 @@ cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat
   const cv::Rect box = cv::boundingRect(points);
   for (int y = box.y; y < box.br().y; y += tiling.core)
     for (int x = box.x; x < box.br().x; x += tiling.core) {
-      const cv::Rect core = cv::Rect(x, y, tiling.core, tiling.core) & box;
-      if (cv::countNonZero(fill(core)) == 0) continue;
+      const cv::Rect cell = cv::Rect(x, y, tiling.core, tiling.core) & box;
+      std::vector<cv::Point> in_cell;
+      cv::findNonZero(fill(cell), in_cell);
+      if (in_cell.empty()) continue;
+      // run on the fill's own box within the cell: sparse cells cost a small window
+      const cv::Rect core = cv::boundingRect(in_cell) + cell.tl();
       fill_core(net, image, known, fill, core, tiling.halo, result, pool);
     }
   return result;
