@@ -4,8 +4,9 @@
 
 namespace ampi::bench {
 
-// ampi bench kernels [--threads N] [--runs N] [--out FILE]: convolution kernels of every
-// runnable ISA against the machine's FMA peak and memory bandwidth (kernels_bench.cpp).
+// ampi bench kernels [--threads N] [--runs N] [--clock wall|cpu] [--out FILE]: convolution
+// kernels of every runnable ISA against the machine's FMA peak and memory bandwidth
+// (kernels_bench.cpp).
 int kernels_benchmark(int argc, char** argv);
 
 // ampi bench render [--frames N] [--naive-frames N] [--size WxH] [--planes N] [--out FILE]:

@@ -15,8 +15,51 @@
 
 namespace ampi {
 
+// ---- convolution micro-kernel arguments (used by the "convolution" entries below) ------
+// One GEMM tile: C[i][j] = act(bias[j] + sum_kk A[i][kk] * B[kk][j]) (+ R[i][j]) for
+// i < m, j < n. B and bias come packed (kernels/conv.h, pack_gemm_weights): ceil(n / nr)
+// panels of nr columns, each [bias: nr][k][nr], zero padded past n.
+struct GemmArgs {
+  int m = 0, n = 0, k = 0;          // rows (1..gemm_mr), output columns, reduction length
+  const float* a = nullptr;         // m rows of k floats, a_stride floats apart
+  int64_t a_stride = 0;
+  const float* packed = nullptr;    // packed bias and B for this table's gemm_nr
+  float* c = nullptr;               // m rows of n floats, c_stride floats apart
+  int64_t c_stride = 0;
+  const float* residual = nullptr;  // nullptr, or laid out like c (same stride)
+  ActivationSpec act;
+};
+
+// One output row of a depthwise convolution (channel multiplier 1), NHWC:
+// out[x][c] = act(bias[c] + sum_{ky,kx} w[ky][kx][c] * row_ky[x*stride_w - pad_left +
+// kx*dilation_w][c]) (+ residual[x][c]); taps outside the row or on a padding row count 0.
+struct DepthwiseRowArgs {
+  const float* const* in_rows = nullptr;  // kernel_h input rows; nullptr: a padding row
+  int in_w = 0, channels = 0;
+  int kernel_h = 0, kernel_w = 0, stride_w = 1, dilation_w = 1, pad_left = 0;
+  int out_w = 0;
+  // Output columns [interior_begin, interior_end) have all kernel_w taps inside the row,
+  // so kernels may skip the bounds checks there.
+  int interior_begin = 0, interior_end = 0;
+  const float* weights = nullptr;   // [kernel_h][kernel_w][channels]
+  const float* bias = nullptr;      // [channels]
+  float* out = nullptr;             // [out_w][channels]
+  const float* residual = nullptr;  // nullptr or [out_w][channels]
+  ActivationSpec act;
+  // The input row the next output row reads first and this one does not (nullptr if
+  // none): kernels may prefetch it at the columns they are reading, so the next call
+  // finds it in cache instead of waiting for memory.
+  const float* prefetch_row = nullptr;
+};
+
 struct KernelTable {
   Isa isa = Isa::Scalar;
+
+  // ---- convolution -------------------------------------------------------------------
+  // The register tile of gemm: rows of A per call (m <= gemm_mr), columns per packed panel.
+  int gemm_mr = 0, gemm_nr = 0;
+  void (*gemm)(const GemmArgs& args) = nullptr;
+  void (*depthwise_row)(const DepthwiseRowArgs& args) = nullptr;
 
   // ---- element-wise ------------------------------------------------------------------
   // out[i] = act(a[i] + b[i]) for i in [0, n). out may alias a or b.

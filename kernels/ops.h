@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "engine/thread_pool.h"
+#include "kernels/conv.h"
 #include "kernels/kernel_table.h"
 
 namespace ampi {

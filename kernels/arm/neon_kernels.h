@@ -3,6 +3,7 @@
 #include <cstdint>
 
 #include "kernels/activation.h"
+#include "kernels/kernel_table.h"
 
 namespace ampi::neon {
 
@@ -20,5 +21,11 @@ void haar_dwt(const float* in, int h, int w, int c, int row_begin, int row_end, 
 void haar_idwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
 void resize2x_nearest(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
 void resize2x_bilinear(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+
+// Convolution micro-kernels (conv_gemm_neon.cpp: 8x8 GEMM tile;
+// conv_depthwise_neon.cpp); contracts in kernels/kernel_table.h.
+constexpr int kGemmMr = 8, kGemmNr = 8;
+void gemm_8x8(const GemmArgs& args);
+void depthwise_row(const DepthwiseRowArgs& args);
 
 }  // namespace ampi::neon

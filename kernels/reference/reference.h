@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "kernels/activation.h"
+#include "kernels/kernel_table.h"
 
 namespace ampi::reference {
 
@@ -23,5 +24,12 @@ void haar_dwt(const float* in, int h, int w, int c, int row_begin, int row_end, 
 void haar_idwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
 void resize2x_nearest(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
 void resize2x_bilinear(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+
+// ---- convolution (conv_gemm.cpp, conv_depthwise.cpp); contracts in kernel_table.h -----
+// A 4x8 GEMM tile (written plainly; the compiler may auto-vectorise it) and one depthwise
+// row. The naive direct convolution the tests compare with is in conv_reference.h.
+constexpr int kGemmMr = 4, kGemmNr = 8;
+void gemm(const GemmArgs& args);
+void depthwise_row(const DepthwiseRowArgs& args);
 
 }  // namespace ampi::reference

@@ -6,6 +6,10 @@ namespace ampi {
 void fill_scalar_kernels(KernelTable& t) {
   t.add = reference::add;
   t.activate = reference::activate;
+  t.gemm_mr = reference::kGemmMr;
+  t.gemm_nr = reference::kGemmNr;
+  t.gemm = reference::gemm;
+  t.depthwise_row = reference::depthwise_row;
   t.gated_output = reference::gated_output;
   t.concat_channels = reference::concat_channels;
   t.channel_sum = reference::channel_sum;

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "kernels/activation.h"
+#include "kernels/kernel_table.h"
 
 namespace ampi::avx2 {
 
@@ -21,5 +22,11 @@ void haar_dwt(const float* in, int h, int w, int c, int row_begin, int row_end, 
 void haar_idwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
 void resize2x_nearest(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
 void resize2x_bilinear(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
+
+// Convolution micro-kernels (conv_gemm_avx2.cpp: 6x16 GEMM tile;
+// conv_depthwise_avx2.cpp); contracts in kernels/kernel_table.h.
+constexpr int kGemmMr = 6, kGemmNr = 16;
+void gemm_6x16(const GemmArgs& args);
+void depthwise_row(const DepthwiseRowArgs& args);
 
 }  // namespace ampi::avx2

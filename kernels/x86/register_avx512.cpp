@@ -6,6 +6,10 @@ namespace ampi {
 void fill_avx512_kernels(KernelTable& t) {
   t.add = avx512::add;
   t.activate = avx512::activate_inplace;
+  t.gemm_mr = avx512::kGemmMr;
+  t.gemm_nr = avx512::kGemmNr;
+  t.gemm = avx512::gemm_12x32;
+  t.depthwise_row = avx512::depthwise_row;
   t.gated_output = avx512::gated_output;
   t.concat_channels = avx512::concat_channels;
   t.channel_sum = avx512::channel_sum;

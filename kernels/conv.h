@@ -1,0 +1,91 @@
+// 2-D convolution, the op the depth and inpainting networks spend their time in.
+//
+// Layouts: input NHWC [in_h][in_w][in_c], output [out_h][out_w][out_c], weights OHWI
+// [out_c][kernel_h][kernel_w][in_c / groups] (PyTorch's OIHW transposed), bias [out_c].
+// The epilogue is fused: out = act(conv(in) + bias) + residual.
+//
+// Conv2d packs its weights once, for one dispatch table, and picks one of three paths by
+// shape (the choice is fixed at construction):
+//   pointwise  1x1, stride 1, no padding, groups 1: the input already is the GEMM's A
+//              matrix (pixels x in_c); the table's gemm tile runs on it directly.
+//   depthwise  groups == in_c == out_c: the table's depthwise_row kernel, one output row
+//              per call, vectorised across channels.
+//   general    anything else: per pixel tile and group, im2col into a per-thread scratch
+//              buffer, then the same gemm tile.
+// Threads split the output pixels (pointwise, general) or output rows (depthwise); every
+// output value is computed by the same code in the same order whatever the thread count,
+// so results are bitwise identical across thread counts.
+#pragma once
+#include <cstdint>
+#include <memory>
+
+#include "engine/thread_pool.h"
+#include "kernels/kernel_table.h"
+
+namespace ampi {
+
+struct ConvParams {
+  int in_c = 0, out_c = 0;
+  int kernel_h = 1, kernel_w = 1;
+  int stride_h = 1, stride_w = 1;
+  int pad_top = 0, pad_left = 0, pad_bottom = 0, pad_right = 0;
+  int dilation_h = 1, dilation_w = 1;
+  int groups = 1;
+  ActivationSpec act;
+
+  // (in_h + pad_top + pad_bottom - dilation_h*(kernel_h-1) - 1)/stride_h + 1; zero or
+  // less when the dilated kernel does not fit.
+  int out_h(int in_h) const;
+  int out_w(int in_w) const;
+};
+
+// Throws std::runtime_error naming the first invalid field ("conv: groups 3 does not
+// divide in_c 16").
+void validate(const ConvParams& p);
+
+// Packs GEMM weights for a table whose tile is nr columns wide: b is [n][k] row-major
+// (n output channels of k weights: one OHWI filter per row), bias [n] or nullptr.
+// Writes ceil(n / nr) panels of (1 + k) * nr floats: the panel's bias, then for each kk
+// the nr weights b[j][kk]; columns past n are zero. Returns the floats written.
+int64_t gemm_packed_size(int n, int k, int nr);
+void pack_gemm_weights(const float* b, const float* bias, int n, int k, int nr, float* packed);
+
+class Conv2d {
+ public:
+  enum class Path { Pointwise, Depthwise, General };
+
+  Conv2d() = default;
+  // weights OHWI [out_c][kernel_h][kernel_w][in_c/groups]; bias [out_c] or nullptr.
+  // Packs the weights once, for the table's ISA. Validates the params (throws).
+  Conv2d(const ConvParams& p, const float* weights, const float* bias,
+         const KernelTable& k = kernels());
+
+  const ConvParams& params() const { return p_; }
+  Path path() const { return path_; }
+
+  // in: NHWC [in_h][in_w][in_c]; out: [out_h][out_w][out_c];
+  // out = act(conv(in) + bias) + residual   (residual: nullptr or the shape of out)
+  // in and out never alias. Uses the pool for threading. Throws std::runtime_error on an
+  // empty Conv2d or an input too small for the dilated kernel.
+  void run(const float* in, int in_h, int in_w, float* out, const float* residual = nullptr,
+           ThreadPool& pool = default_pool()) const;
+
+ private:
+  void run_pointwise(const float* in, int64_t pixels, float* out, const float* residual,
+                     ThreadPool& pool) const;
+  void run_depthwise(const float* in, int in_h, int in_w, float* out, const float* residual,
+                     ThreadPool& pool) const;
+  void run_general(const float* in, int in_h, int in_w, float* out, const float* residual,
+                   ThreadPool& pool) const;
+
+  ConvParams p_;
+  Path path_ = Path::General;
+  const KernelTable* k_ = nullptr;
+  // Packed weights, immutable after construction (shared by copies of this Conv2d).
+  // Pointwise/general: one pack_gemm_weights block per group, group_stride_ floats apart.
+  // Depthwise: [kernel_h][kernel_w][channels] weights, then [channels] bias.
+  std::shared_ptr<const float> packed_;
+  int64_t group_stride_ = 0;
+};
+
+}  // namespace ampi

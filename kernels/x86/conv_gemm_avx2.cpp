@@ -1,0 +1,81 @@
+// AVX2 + FMA GEMM tile, 6 rows x 16 columns (two vectors): 12 accumulators, 2 weight
+// vectors and one broadcast fill 15 of the 16 ymm registers, and 12 independent FMA
+// chains cover the FMA latency (4 cycles) on two FMA ports. A panel whose last columns
+// fit in one vector runs a 6x8 tile instead of multiplying zeros.
+#include <algorithm>
+
+#include "kernels/conv_epilogue.h"
+#include "kernels/x86/avx2_kernels.h"
+#include "kernels/x86/avx2_math.h"
+
+namespace ampi::avx2 {
+namespace {
+
+// Lanes [0, count) set.
+__m256i lane_mask(int count) {
+  return _mm256_cmpgt_epi32(_mm256_set1_epi32(count), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+}
+
+// Stores v (+ residual) into `columns` floats of c
+// (columns >= 1; only the first 8 are written).
+inline void store_columns(__m256 v, float* c, const float* residual, int columns) {
+  if (columns >= 8) {
+    if (residual) v = _mm256_add_ps(v, _mm256_loadu_ps(residual));
+    _mm256_storeu_ps(c, v);
+  } else {
+    const __m256i m = lane_mask(columns);
+    if (residual) v = _mm256_add_ps(v, _mm256_maskload_ps(residual, m));
+    _mm256_maskstore_ps(c, m, v);
+  }
+}
+
+// Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel;
+// columns <= 8 * kVectors.
+template <int kVectors>
+void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
+  const int m = g.m, k = g.k;
+  // Rows past m re-read row m-1 (their results are dropped): no branches in the k loop.
+  const float* a[kGemmMr];
+  for (int r = 0; r < kGemmMr; ++r) a[r] = g.a + std::min(r, m - 1) * g.a_stride;
+  __m256 acc[kGemmMr][kVectors];
+  for (int v = 0; v < kVectors; ++v) {
+    const __m256 bias = _mm256_loadu_ps(panel + 8 * v);
+    for (int r = 0; r < kGemmMr; ++r) acc[r][v] = bias;
+  }
+  const float* b = panel + kGemmNr;
+  for (int kk = 0; kk < k; ++kk, b += kGemmNr) {
+    __m256 bv[kVectors];
+    for (int v = 0; v < kVectors; ++v) bv[v] = _mm256_loadu_ps(b + 8 * v);
+    for (int r = 0; r < kGemmMr; ++r) {
+      const __m256 av = _mm256_broadcast_ss(a[r] + kk);
+      for (int v = 0; v < kVectors; ++v) acc[r][v] = _mm256_fmadd_ps(av, bv[v], acc[r][v]);
+    }
+  }
+  // Unrolled, so every acc index is a constant and the accumulators live in registers
+  // only (a runtime row loop here makes GCC mirror them to the stack in the k loop).
+#pragma GCC unroll 16
+  for (int r = 0; r < kGemmMr; ++r) {
+    if (r >= m) continue;
+    activate_tile(acc[r], g.act, [](__m256 x, ActivationSpec a) { return activate(x, a); });
+    float* c = g.c + r * g.c_stride + j0;
+    const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
+    for (int v = 0; v < kVectors; ++v)
+      store_columns(acc[r][v], c + 8 * v, res ? res + 8 * v : nullptr, columns - 8 * v);
+  }
+}
+
+}  // namespace
+
+void gemm_6x16(const GemmArgs& g) {
+  const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
+  const float* panel = g.packed;
+  for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats) {
+    const int columns = std::min(kGemmNr, g.n - j0);
+    if (columns > 8)
+      panel_tile<2>(g, panel, j0, columns);
+    else
+      panel_tile<1>(g, panel, j0, columns);
+  }
+}
+
+}  // namespace ampi::avx2

@@ -1,0 +1,75 @@
+// AVX-512 GEMM tile, 12 rows x 32 columns (two vectors): 24 accumulators, 2 weight
+// vectors and one broadcast in the 32 zmm registers; the broadcast folds into the FMA's
+// memory operand. A panel whose last columns fit in one vector runs a 12x16 tile.
+// Column tails use masked loads and stores, so no lane outside the output is touched.
+#include <algorithm>
+
+#include "kernels/conv_epilogue.h"
+#include "kernels/x86/avx512_kernels.h"
+#include "kernels/x86/avx512_math.h"
+
+namespace ampi::avx512 {
+namespace {
+
+// Lanes [0, count) set; count >= 16 sets all.
+inline __mmask16 lane_mask(int count) {
+  return count >= 16 ? static_cast<__mmask16>(0xffff) : static_cast<__mmask16>((1u << count) - 1u);
+}
+
+// Stores v (+ residual) into `columns` floats of c.
+inline void store_columns(__m512 v, float* c, const float* residual, int columns) {
+  const __mmask16 m = lane_mask(columns);
+  if (residual) v = _mm512_add_ps(v, _mm512_maskz_loadu_ps(m, residual));
+  _mm512_mask_storeu_ps(c, m, v);
+}
+
+// Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel;
+// columns <= 16 * kVectors.
+template <int kVectors>
+void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
+  const int m = g.m, k = g.k;
+  // Rows past m re-read row m-1 (their results are dropped): no branches in the k loop.
+  const float* a[kGemmMr];
+  for (int r = 0; r < kGemmMr; ++r) a[r] = g.a + std::min(r, m - 1) * g.a_stride;
+  __m512 acc[kGemmMr][kVectors];
+  for (int v = 0; v < kVectors; ++v) {
+    const __m512 bias = _mm512_loadu_ps(panel + 16 * v);
+    for (int r = 0; r < kGemmMr; ++r) acc[r][v] = bias;
+  }
+  const float* b = panel + kGemmNr;
+  for (int kk = 0; kk < k; ++kk, b += kGemmNr) {
+    __m512 bv[kVectors];
+    for (int v = 0; v < kVectors; ++v) bv[v] = _mm512_loadu_ps(b + 16 * v);
+    for (int r = 0; r < kGemmMr; ++r) {
+      const __m512 av = _mm512_set1_ps(a[r][kk]);
+      for (int v = 0; v < kVectors; ++v) acc[r][v] = _mm512_fmadd_ps(av, bv[v], acc[r][v]);
+    }
+  }
+  // Unrolled, so every acc index is a constant and the accumulators live in registers
+  // only (a runtime row loop here makes GCC mirror them to the stack in the k loop).
+#pragma GCC unroll 16
+  for (int r = 0; r < kGemmMr; ++r) {
+    if (r >= m) continue;
+    activate_tile(acc[r], g.act, [](__m512 x, ActivationSpec a) { return activate(x, a); });
+    float* c = g.c + r * g.c_stride + j0;
+    const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
+    for (int v = 0; v < kVectors; ++v)
+      store_columns(acc[r][v], c + 16 * v, res ? res + 16 * v : nullptr, columns - 16 * v);
+  }
+}
+
+}  // namespace
+
+void gemm_12x32(const GemmArgs& g) {
+  const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
+  const float* panel = g.packed;
+  for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats) {
+    const int columns = std::min(kGemmNr, g.n - j0);
+    if (columns > 16)
+      panel_tile<2>(g, panel, j0, columns);
+    else
+      panel_tile<1>(g, panel, j0, columns);
+  }
+}
+
+}  // namespace ampi::avx512

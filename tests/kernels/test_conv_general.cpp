@@ -1,0 +1,103 @@
+// General convolution (im2col + GEMM): every kernel size, stride, padding, dilation and
+// group count the networks use, every runnable ISA against the direct reference.
+#include "test_conv_util.h"
+
+using namespace ampi;
+using namespace ampi::test;
+
+namespace {
+
+ConvCase general(int in_c, int out_c, int kernel, int stride, int dilation, int groups, int h, int w,
+                 uint32_t seed) {
+  ConvCase c;
+  c.p.in_c = in_c;
+  c.p.out_c = out_c;
+  c.p.kernel_h = c.p.kernel_w = kernel;
+  c.p.stride_h = c.p.stride_w = stride;
+  c.p.dilation_h = c.p.dilation_w = dilation;
+  c.p.groups = groups;
+  c.in_h = h;
+  c.in_w = w;
+  c.seed = seed;
+  return c;
+}
+
+void set_padding(ConvCase& c, int top, int left, int bottom, int right) {
+  c.p.pad_top = top;
+  c.p.pad_left = left;
+  c.p.pad_bottom = bottom;
+  c.p.pad_right = right;
+}
+
+bool fits(const ConvCase& c) { return c.p.out_h(c.in_h) > 0 && c.p.out_w(c.in_w) > 0; }
+
+}  // namespace
+
+TEST_CASE("general conv matches the reference: kernels, strides, paddings, dilations, groups") {
+  ThreadPool pool(2);
+  struct Pad {
+    int top, left, bottom, right;
+  };
+  const std::vector<Pad> pads = sweep<Pad>({{0, 0, 0, 0}, {1, 1, 1, 1}, {2, 2, 2, 2}, {1, 0, 2, 3}},
+                                           {{1, 1, 1, 1}, {1, 0, 2, 3}});
+  uint32_t seed = 7000;
+  for (int kernel : sweep<int>({1, 3, 5, 7}, {1, 3, 5}))
+    for (int stride : {1, 2})
+      for (const Pad& pad : pads)
+        for (int dilation : sweep<int>({1, 2, 4}, {1, 2}))
+          for (int groups : {1, 2}) {
+            ConvCase c = general(6, 10, kernel, stride, dilation, groups, 13, 15, seed++);
+            set_padding(c, pad.top, pad.left, pad.bottom, pad.right);
+            if (fits(c)) check_all_isas(c, pool);
+          }
+}
+
+TEST_CASE("general 3x3 conv matches the reference over input and output channel counts") {
+  ThreadPool pool(2);
+  const std::vector<int> counts = sweep<int>({1, 3, 4, 8, 9, 16, 17, 32, 33}, {3, 9, 17});
+  uint32_t seed = 8000;
+  for (int in_c : counts)
+    for (int out_c : counts) {
+      ConvCase c = general(in_c, out_c, 3, 1, 1, 1, 7, 9, seed++);
+      set_padding(c, 1, 1, 1, 1);
+      check_all_isas(c, pool);
+    }
+}
+
+TEST_CASE("general conv matches the reference for grouped and rectangular layers") {
+  ThreadPool pool(2);
+  uint32_t seed = 9000;
+  SECTION("four groups, 33 outputs per group (more than one panel)") {
+    ConvCase c = general(12, 132, 3, 1, 1, 4, 6, 7, seed++);
+    set_padding(c, 1, 1, 1, 1);
+    check_all_isas(c, pool);
+  }
+  SECTION("channel multiplier 2 (groups == in_c, out_c = 2 in_c)") {
+    ConvCase c = general(9, 18, 3, 2, 1, 9, 9, 11, seed++);
+    set_padding(c, 1, 1, 1, 1);
+    check_all_isas(c, pool);
+  }
+  SECTION("1x1 with stride 2, and 1x1 with padding") {
+    check_all_isas(general(16, 24, 1, 2, 1, 1, 9, 11, seed++), pool);
+    ConvCase padded = general(16, 24, 1, 1, 1, 1, 5, 6, seed++);
+    set_padding(padded, 1, 0, 0, 2);
+    check_all_isas(padded, pool);
+  }
+  SECTION("1x7, 7x1 and 3x5 kernels with mixed strides and dilations") {
+    ConvCase row = general(5, 11, 1, 1, 1, 1, 6, 17, seed++);
+    row.p.kernel_w = 7;
+    set_padding(row, 0, 3, 0, 3);
+    check_all_isas(row, pool);
+    ConvCase column = general(5, 11, 1, 1, 1, 1, 17, 6, seed++);
+    column.p.kernel_h = 7;
+    column.p.stride_h = 2;
+    set_padding(column, 3, 0, 3, 0);
+    check_all_isas(column, pool);
+    ConvCase mixed = general(8, 12, 3, 1, 1, 2, 14, 19, seed++);
+    mixed.p.kernel_w = 5;
+    mixed.p.stride_w = 2;
+    mixed.p.dilation_h = 2;
+    set_padding(mixed, 2, 4, 1, 0);
+    check_all_isas(mixed, pool);
+  }
+}

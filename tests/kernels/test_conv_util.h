@@ -1,0 +1,136 @@
+// Helpers shared by the convolution tests: one random layer per seed, the comparison of
+// Conv2d (any table, any pool) with the naive direct reference, and the small mode.
+#pragma once
+#include <catch2/catch.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "kernels/conv.h"
+#include "kernels/reference/conv_reference.h"
+#include "support/random.h"
+
+namespace ampi::test {
+
+// AMPI_TEST_SMALL=1 trims the sweeps to what runs in seconds under qemu (~150x slower).
+inline bool small_mode() {
+  const char* v = std::getenv("AMPI_TEST_SMALL");
+  return v && *v && std::strcmp(v, "0") != 0;
+}
+
+// Picks the full or the small list.
+template <typename T>
+std::vector<T> sweep(std::vector<T> full, std::vector<T> small) {
+  return small_mode() ? small : full;
+}
+
+inline const std::vector<ActivationSpec>& all_activations() {
+  static const std::vector<ActivationSpec> list = {
+      {Activation::None},      {Activation::ReLU},      {Activation::ReLU6},
+      {Activation::HardSwish}, {Activation::HardSigmoid}, {Activation::Sigmoid},
+      {Activation::LeakyReLU, 0.1f}, {Activation::ELU, 1.0f}, {Activation::Tanh}};
+  return list;
+}
+
+struct ConvCase {
+  ConvParams p;
+  int in_h = 1, in_w = 1;
+  bool residual = false;
+  uint32_t seed = 1;
+};
+
+inline std::string describe(const ConvCase& c) {
+  const ConvParams& p = c.p;
+  std::ostringstream s;
+  s << "in " << c.in_h << "x" << c.in_w << "x" << p.in_c << ", out_c " << p.out_c << ", kernel "
+    << p.kernel_h << "x" << p.kernel_w << ", stride " << p.stride_h << "x" << p.stride_w
+    << ", pad t" << p.pad_top << " l" << p.pad_left << " b" << p.pad_bottom << " r" << p.pad_right
+    << ", dilation " << p.dilation_h << "x" << p.dilation_w << ", groups " << p.groups << ", "
+    << activation_name(p.act.kind) << (c.residual ? ", residual" : "") << ", seed " << c.seed;
+  return s.str();
+}
+
+// The random tensors of one case, all from its seed.
+struct ConvData {
+  std::vector<float> in, weights, bias, residual;
+  explicit ConvData(const ConvCase& c) {
+    const ConvParams& p = c.p;
+    const size_t out_size = static_cast<size_t>(p.out_h(c.in_h)) * p.out_w(c.in_w) * p.out_c;
+    in = random_floats(static_cast<size_t>(c.in_h) * c.in_w * p.in_c, c.seed);
+    weights = random_floats(static_cast<size_t>(p.out_c) * p.kernel_h * p.kernel_w * (p.in_c / p.groups),
+                            c.seed + 1);
+    bias = random_floats(p.out_c, c.seed + 2);
+    if (c.residual) residual = random_floats(out_size, c.seed + 3, -4.0f, 4.0f);
+  }
+  const float* residual_or_null() const { return residual.empty() ? nullptr : residual.data(); }
+};
+
+inline float max_abs(const std::vector<float>& v) {
+  float m = 0.0f;
+  for (float x : v) m = std::max(m, std::fabs(x));
+  return m;
+}
+
+// Expected output and the error scale of a case: the reference convolution before the
+// epilogue, then the epilogue. Error is judged relative to the magnitude of the values
+// the kernels sum (pre-activation plus residual): an activation can shrink the output
+// (sigmoid of a large sum) but not the rounding error of the sum before it.
+struct Expected {
+  std::vector<float> out;
+  float scale = 0.0f;
+};
+
+inline Expected expected_output(const ConvCase& c, const ConvData& d) {
+  ConvParams linear = c.p;
+  linear.act = {};
+  Expected e;
+  e.out.resize(static_cast<size_t>(c.p.out_h(c.in_h)) * c.p.out_w(c.in_w) * c.p.out_c);
+  reference::conv2d_direct(linear, d.in.data(), c.in_h, c.in_w, d.weights.data(), d.bias.data(),
+                           nullptr, e.out.data());
+  e.scale = std::max(1e-3f, max_abs(e.out) + max_abs(d.residual));
+  for (size_t i = 0; i < e.out.size(); ++i)
+    e.out[i] = ampi::activate(e.out[i], c.p.act) + (d.residual.empty() ? 0.0f : d.residual[i]);
+  return e;
+}
+
+constexpr float kRelativeTolerance = 1e-5f;
+
+// Floats past the end of the output that must stay untouched (a full AVX-512 vector and
+// more): catches tail stores that spill over.
+constexpr size_t kGuardFloats = 64;
+constexpr float kGuardValue = 12345.0f;
+
+// Runs Conv2d; the output starts as NaN so an unwritten value cannot pass.
+inline std::vector<float> run_conv(const ConvCase& c, const ConvData& d, const KernelTable& k,
+                                   ThreadPool& pool) {
+  const Conv2d conv(c.p, d.weights.data(), d.bias.data(), k);
+  const size_t size = static_cast<size_t>(c.p.out_h(c.in_h)) * c.p.out_w(c.in_w) * c.p.out_c;
+  std::vector<float> out(size + kGuardFloats, kGuardValue);
+  std::fill(out.begin(), out.begin() + size, NAN);
+  conv.run(d.in.data(), c.in_h, c.in_w, out.data(), d.residual_or_null(), pool);
+  const bool guard_intact =
+      std::all_of(out.begin() + size, out.end(), [](float v) { return v == kGuardValue; });
+  CHECK(guard_intact);
+  out.resize(size);
+  return out;
+}
+
+// Conv2d on every runnable table (the pool's thread count) against the reference.
+inline void check_all_isas(const ConvCase& c, ThreadPool& pool) {
+  const ConvData d(c);
+  const Expected e = expected_output(c, d);
+  for (Isa isa : runnable_isas()) {
+    INFO(describe(c) << ", isa " << isa_name(isa) << ", threads " << pool.size());
+    const std::vector<float> got = run_conv(c, d, kernels_for(isa), pool);
+    const float err = max_abs_diff(e.out.data(), got.data(), got.size());
+    INFO("max error " << err << ", scale " << e.scale);
+    REQUIRE(err <= kRelativeTolerance * e.scale);
+  }
+}
+
+}  // namespace ampi::test
