@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/memory_budget.h"
+
 namespace ampi {
 
 static size_t round64(size_t bytes) { return (bytes + 63) / 64 * 64; }
@@ -22,7 +24,7 @@ size_t Arena::unshared_bytes() const {
   return sum;
 }
 
-size_t Arena::plan() {
+size_t Arena::plan(const std::string& owner) {
   if (planned_) return total_;
   std::vector<int> order(requests_.size());
   std::iota(order.begin(), order.end(), 0);
@@ -49,6 +51,7 @@ size_t Arena::plan() {
     total_ = std::max(total_, offset + r.bytes);
     placed.push_back(id);
   }
+  check_allocation(total_, owner, "its activations (" + std::to_string(requests_.size()) + " buffers)");
   block_ = aligned_alloc64(total_);
   planned_ = true;
   return total_;

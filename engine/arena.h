@@ -8,6 +8,7 @@
 // the peak of simultaneously live bytes rather than the sum of all buffers.
 #pragma once
 #include <cstddef>
+#include <string>
 #include <vector>
 
 #include "engine/tensor.h"
@@ -19,8 +20,10 @@ class Arena {
   // Declares a buffer of `bytes` used from step `first` to step `last` inclusive; returns
   // its id. Only before plan().
   int request(size_t bytes, int first, int last);
-  // Assigns offsets and allocates the block. Returns the block size in bytes.
-  size_t plan();
+  // Assigns offsets and allocates the block. Returns the block size in bytes. A block
+  // over the memory budget (engine/memory_budget.h) throws MemoryBudgetError naming
+  // `owner` (e.g. "depth network (lite) at 1024x768") before anything is allocated.
+  size_t plan(const std::string& owner = "network");
 
   size_t total_bytes() const { return total_; }
   // Sum of all requests: what the network would need without reuse.

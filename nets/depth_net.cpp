@@ -155,10 +155,11 @@ class Plan {
   void push(Step step) { steps_.push_back(std::move(step)); }
   const Value& value(int v) const { return values_.at(v); }
 
-  void allocate() {
+  // `owner` names the network in a memory-budget error.
+  void allocate(const std::string& owner) {
     for (Value& v : values_)
       v.arena_id = arena_.request(size_t(v.h) * v.w * v.c * sizeof(float), v.first, v.last);
-    arena_.plan();
+    arena_.plan(owner);
   }
   float* data(int v) { return static_cast<float*>(arena_.data(values_[v].arena_id)); }
   void execute(ThreadPool& pool) {
@@ -344,7 +345,7 @@ std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
   p->consume(coeffs);
   p->push([&k, coeffs, out, lh, lw](Plan& pl, ThreadPool& pool) { haar_idwt(pl.data(coeffs), lh, lw, 1, pl.data(out), pool, k); });
   p->output = out;
-  p->allocate();
+  p->allocate("depth network (" + variant + ") at " + std::to_string(w) + "x" + std::to_string(h));
   return p;
 }
 
