@@ -10,6 +10,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 
+#include "engine/memory_budget.h"
+
 namespace fs = std::filesystem;
 
 namespace ampi {
@@ -161,10 +163,28 @@ Plane read_plane(const cv::FileNode& node, const std::string& path, const std::s
   return p;
 }
 
+// Layers are PNGs: their IHDR chunk gives the size before the decoder allocates it, so a
+// layer that claims to be huge is refused here rather than decoded (other formats are
+// bounded by OpenCV's own limit, OPENCV_IO_MAX_IMAGE_PIXELS).
+void check_png_layer_size(const std::string& path, const Camera& c) {
+  unsigned char header[24];
+  std::ifstream in(path, std::ios::binary);
+  if (!in.read(reinterpret_cast<char*>(header), sizeof header)) return;  // imread says what is wrong
+  if (std::memcmp(header, "\x89PNG\r\n\x1a\n", 8) != 0 || std::memcmp(header + 12, "IHDR", 4) != 0) return;
+  const auto big_endian32 = [&](int at) {
+    return uint32_t(header[at]) << 24 | uint32_t(header[at + 1]) << 16 | uint32_t(header[at + 2]) << 8 | header[at + 3];
+  };
+  const uint32_t width = big_endian32(16), height = big_endian32(20);
+  if (width != uint32_t(c.width) || height != uint32_t(c.height))
+    fail(path, "is " + std::to_string(width) + "x" + std::to_string(height) + " but mpi.json says " +
+                   size_text(c.width, c.height));
+}
+
 cv::Mat read_layer(const fs::path& file, const Camera& c) {
   const std::string path = file.string();
   std::error_code ec;
   if (!fs::is_regular_file(file, ec)) fail(path, "missing layer file");
+  check_png_layer_size(path, c);
   const cv::Mat layer = cv::imread(path, cv::IMREAD_UNCHANGED);
   if (layer.empty()) fail(path, "not a readable image");
   check_layer(layer, c, path);
@@ -241,6 +261,8 @@ Mpi read_mpi(const std::string& dir) {
   for (size_t j = 0; j < planes.size(); ++j)
     mpi.planes.push_back(read_plane(planes[static_cast<int>(j)], path, "planes[" + std::to_string(j) + "]", &names[j]));
   check_description(mpi, path);
+  check_allocation(bytes_for({names.size(), uint64_t(mpi.camera.width), uint64_t(mpi.camera.height), 4}), path,
+                   std::to_string(names.size()) + " RGBA layers at " + size_text(mpi.camera.width, mpi.camera.height));
   for (const std::string& name : names) mpi.layers.push_back(read_layer(fs::path(dir) / name, mpi.camera));
   return mpi;
 }

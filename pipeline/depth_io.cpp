@@ -6,14 +6,18 @@
 #include <cctype>
 #include <cerrno>
 #include <climits>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <stdexcept>
 #include <vector>
 
+#include "engine/memory_budget.h"
 #include "mpi/mpi_io.h"
+#include "pipeline/photo_io.h"
 #include "weights_format/npy.h"
 
 namespace ampi {
@@ -43,9 +47,19 @@ void check_png_complete(const std::string& path, const std::vector<unsigned char
   if (b.size() < 20 || std::memcmp(&b[b.size() - 8], "IEND", 4) != 0) fail(path, "truncated PNG (no IEND chunk)");
 }
 
+// Refuses, before decoding, a PNG or JPEG map that would not fit the memory budget: per
+// pixel up to 4 channels of 16 bits decoded plus the float map they become.
+void check_decoded_size(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const std::optional<EncodedImageSize> size = encoded_image_size(bytes);
+  if (!size) return;
+  check_allocation(bytes_for({uint64_t(size->width), uint64_t(size->height), 4 * 2 + sizeof(float)}), path,
+                   "the decoded " + std::to_string(size->width) + "x" + std::to_string(size->height) + " depth map");
+}
+
 cv::Mat decode_image(const std::string& path) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
   check_png_complete(path, bytes);
+  check_decoded_size(path, bytes);
   cv::Mat image;
   try {
     image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
@@ -92,7 +106,15 @@ void invert_distances(cv::Mat& map, const std::string& path) {
   const float farthest_disparity = 1.0f / farthest;
   for (int y = 0; y < map.rows; ++y) {
     float* v = map.ptr<float>(y);
-    for (int x = 0; x < map.cols; ++x) v[x] = v[x] > 0.0f ? 1.0f / v[x] : farthest_disparity;
+    for (int x = 0; x < map.cols; ++x) {
+      if (v[x] > 0.0f && !std::isfinite(1.0f / v[x])) {  // a denormal distance: 1/x overflows
+        char value[32];
+        std::snprintf(value, sizeof value, "%g", v[x]);
+        fail(path, std::string("distance ") + value + " at (" + std::to_string(x) + ", " + std::to_string(y) +
+                       ") is too small to invert");
+      }
+      v[x] = v[x] > 0.0f ? 1.0f / v[x] : farthest_disparity;
+    }
   }
 }
 

@@ -9,6 +9,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "engine/memory_budget.h"
+
 namespace ampi {
 namespace {
 
@@ -52,11 +54,66 @@ void check_not_truncated(const std::string& path, const std::vector<unsigned cha
   }
 }
 
+uint32_t big_endian(const std::vector<unsigned char>& b, size_t pos, int bytes) {
+  uint32_t value = 0;
+  for (int i = 0; i < bytes; ++i) value = value << 8 | b[pos + i];
+  return value;
+}
+
+// PNG: the signature, then the IHDR chunk (length, "IHDR", width, height, ...).
+std::optional<EncodedImageSize> png_size(const std::vector<unsigned char>& b) {
+  if (b.size() < 24 || std::memcmp(&b[12], "IHDR", 4) != 0) return std::nullopt;
+  return EncodedImageSize{big_endian(b, 16, 4), big_endian(b, 20, 4)};
+}
+
+// JPEG: walks the marker segments after SOI up to the first start-of-frame (SOF0..SOF15
+// but DHT C4, JPG C8 and DAC CC, which share the range), which holds the frame's size.
+std::optional<EncodedImageSize> jpeg_size(const std::vector<unsigned char>& b) {
+  size_t pos = 2;
+  while (pos + 1 < b.size()) {
+    if (b[pos] != 0xFF) return std::nullopt;
+    const unsigned char marker = b[pos + 1];
+    if (marker == 0xFF) {  // fill byte before a marker
+      ++pos;
+      continue;
+    }
+    if (marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) {  // no length field
+      pos += 2;
+      continue;
+    }
+    if (marker == 0xD9 || marker == 0xDA || pos + 4 > b.size()) return std::nullopt;  // EOI, scan data
+    const bool frame = marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC;
+    if (!frame) {
+      pos += 2 + big_endian(b, pos + 2, 2);
+      continue;
+    }
+    // The frame header after the marker: length (2), precision (1), height (2), width (2).
+    if (pos + 9 > b.size()) return std::nullopt;
+    return EncodedImageSize{big_endian(b, pos + 7, 2), big_endian(b, pos + 5, 2)};
+  }
+  return std::nullopt;
+}
+
+// Refuses, before decoding, a PNG or JPEG whose 8-bit BGR image would not fit the budget.
+void check_decoded_size(const std::string& path, const std::vector<unsigned char>& bytes) {
+  const std::optional<EncodedImageSize> size = encoded_image_size(bytes);
+  if (!size) return;
+  check_allocation(bytes_for({uint64_t(size->width), uint64_t(size->height), 3}), path,
+                   "the decoded " + std::to_string(size->width) + "x" + std::to_string(size->height) + " photo");
+}
+
 }  // namespace
+
+std::optional<EncodedImageSize> encoded_image_size(const std::vector<unsigned char>& bytes) {
+  if (starts_with(bytes, "\x89PNG\r\n\x1a\n", 8)) return png_size(bytes);
+  if (starts_with(bytes, "\xFF\xD8", 2)) return jpeg_size(bytes);
+  return std::nullopt;
+}
 
 cv::Mat read_photo(const std::string& path) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
   check_not_truncated(path, bytes);
+  check_decoded_size(path, bytes);
   cv::Mat image;
   try {
     // IMREAD_COLOR applies the EXIF orientation and converts gray, 16-bit, alpha and

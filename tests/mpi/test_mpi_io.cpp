@@ -8,6 +8,7 @@
 #include <sstream>
 #include <string>
 
+#include "engine/memory_budget.h"
 #include "mpi/mpi_io.h"
 
 namespace fs = std::filesystem;
@@ -200,6 +201,13 @@ TEST_CASE("malformed MPI folders give a one-line error naming the file and the p
        "not a readable image"},
       {"layer size mismatch", [&](const std::string& d) { png(d + "/layer_00.png", cv::Mat(5, 8, CV_8UC4)); },
        "layer_00.png", "is 8x5 but mpi.json says 7x5"},
+      {"layer header claims a huge image",  // refused from the header, before decoding
+       [](const std::string& d) {
+         std::string png = read_text(d + "/layer_02.png");
+         png.replace(16, 8, std::string("\0\0\xEA\x60\0\0\xC3\x50", 8));  // 60000 x 50000
+         write_text(d + "/layer_02.png", png);
+       },
+       "layer_02.png", "is 60000x50000 but mpi.json says 7x5"},
       {"layer not RGBA", [&](const std::string& d) { png(d + "/layer_01.png", cv::Mat(5, 7, CV_8UC3)); },
        "layer_01.png", "not an 8-bit RGBA image (3 channels"},
       {"16-bit layer", [&](const std::string& d) { png(d + "/layer_01.png", cv::Mat(5, 7, CV_16UC4)); },
@@ -227,4 +235,16 @@ TEST_CASE("malformed MPI folders give a one-line error naming the file and the p
     CHECK(message.find('\n') == std::string::npos);
     CHECK_THAT(message, Catch::Contains(c.problem));
   }
+}
+
+TEST_CASE("read_mpi refuses layers over the memory budget before decoding any") {
+  TempDir dir;
+  const std::string mpi_dir = dir / "mpi";
+  write_mpi(sample_mpi(5), mpi_dir);
+  edit(mpi_dir + "/mpi.json", "\"width\": 7", "\"width\": 70000");
+  set_memory_budget(uint64_t(1) << 20);
+  const std::string message = read_error(mpi_dir);
+  set_memory_budget(0);
+  CHECK(message == mpi_dir + "/mpi.json: needs 4.0 MiB for 3 RGBA layers at 70000x5, over the 1.0 MiB memory "
+                             "budget (AMPI_MEMORY_BUDGET)");
 }

@@ -1,5 +1,6 @@
 #include <unistd.h>
 
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <cstdio>
 #include <filesystem>
@@ -9,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/memory_budget.h"
 #include "pipeline/photo_io.h"
 
 namespace fs = std::filesystem;
@@ -125,5 +127,44 @@ TEST_CASE("read_photo rejects bad input with one line naming the file") {
     CHECK(message.find(problem) != std::string::npos);
     CHECK(message.find('\n') == std::string::npos);
   }
+  fs::remove_all(dir);
+}
+
+TEST_CASE("encoded_image_size reads PNG and JPEG headers without decoding") {
+  const cv::Mat img = test_image(40, 30);
+  CHECK(encoded_image_size(encode(img, ".png"))->width == 40);
+  CHECK(encoded_image_size(encode(img, ".png"))->height == 30);
+  std::vector<unsigned char> progressive;
+  REQUIRE(cv::imencode(".jpg", img, progressive, {cv::IMWRITE_JPEG_PROGRESSIVE, 1}));
+  // EXIF in front of the frame header: the walk must step over the APP1 segment.
+  for (const auto& jpeg : {encode(img, ".jpg"), progressive, with_exif_orientation(encode(img, ".jpg"), 6)}) {
+    const auto size = encoded_image_size(jpeg);
+    REQUIRE(size);
+    CHECK(size->width == 40);
+    CHECK(size->height == 30);
+  }
+  CHECK_FALSE(encoded_image_size(encode(img, ".bmp")));
+  CHECK_FALSE(encoded_image_size({0xFF, 0xD8, 0xFF, 0xE0, 0x00}));  // cut inside a segment
+  CHECK_FALSE(encoded_image_size({'h', 'e', 'l', 'l', 'o'}));
+}
+
+TEST_CASE("read_photo refuses a photo over the memory budget before decoding it") {
+  const fs::path dir = temp_dir();
+  std::vector<unsigned char> png = encode(test_image(64, 64), ".png");
+  write_bytes(dir / "small.png", png);
+  // The header claims 30000 x 20000: refused from the header alone (the pixel data and
+  // the chunk's checksum no longer match, which only a decoder would notice).
+  const unsigned char claimed[8] = {0, 0, 0x75, 0x30, 0, 0, 0x4E, 0x20};
+  std::copy(std::begin(claimed), std::end(claimed), png.begin() + 16);
+  write_bytes(dir / "huge.png", png);
+  set_memory_budget(uint64_t(1) << 30);
+  const std::string huge = error_of((dir / "huge.png").string());
+  CHECK(huge == (dir / "huge.png").string() +
+                    ": needs 1.7 GiB for the decoded 30000x20000 photo, over the 1.0 GiB memory budget "
+                    "(AMPI_MEMORY_BUDGET)");
+  CHECK(read_photo((dir / "small.png").string()).cols == 64);
+  set_memory_budget(64 * 64 * 3 - 1);
+  CHECK(error_of((dir / "small.png").string()).find("over the") != std::string::npos);
+  set_memory_budget(0);
   fs::remove_all(dir);
 }

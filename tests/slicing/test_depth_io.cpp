@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "engine/memory_budget.h"
 #include "pipeline/depth_io.h"
 #include "weights_format/npy.h"
 
@@ -155,6 +156,11 @@ TEST_CASE("distance maps are inverted; zero distances become the farthest") {
   CHECK(got.at<float>(0, 3) == 2.0f);
   save_npy(dir / "zeros.npy", {2, 2}, {0, 0, 0, -1});
   CHECK_THAT(import_error(dir / "zeros.npy", true), Catch::Contains("no positive value"));
+  // Found by fuzz_depth_map (fuzz/corpus/depth_map/crash-denormal-distance): a positive
+  // denormal distance used to become an infinite disparity.
+  save_npy(dir / "denormal.npy", {1, 3}, {2.0f, 1e-40f, 4.0f});
+  CHECK_THAT(import_error(dir / "denormal.npy", true),
+             Catch::Contains("distance 9.99995e-41 at (1, 0) is too small to invert"));
 }
 
 TEST_CASE("write_depth_png16 normalises to 0..65535 and leaves no temporary file") {
@@ -178,4 +184,17 @@ TEST_CASE("write_depth_png16 normalises to 0..65535 and leaves no temporary file
   CHECK_THROWS_WITH(write_depth_png16(bad, dir / "bad.png"), Catch::StartsWith(dir / "bad.png" + ": "));
   CHECK(!fs::exists(dir / "bad.png"));
   CHECK_THROWS_WITH(write_depth_png16(small_float_map(), dir / "no/such/dir.png"), Catch::Contains("no/such/dir.png"));
+}
+
+TEST_CASE("a depth map over the memory budget is refused before it is decoded") {
+  TempDir dir;
+  std::vector<unsigned char> png;
+  REQUIRE(cv::imencode(".png", cv::Mat(64, 64, CV_16UC1, cv::Scalar(1234)), png));
+  std::ofstream(dir / "map.png", std::ios::binary).write(reinterpret_cast<const char*>(png.data()), png.size());
+  set_memory_budget(64 * 64 * 12 - 1);  // per pixel: 4 x 16 bits decoded + the float map
+  const std::string message = import_error(dir / "map.png");
+  set_memory_budget(0);
+  CHECK(one_line_naming(message, dir / "map.png"));
+  CHECK_THAT(message, Catch::Contains("for the decoded 64x64 depth map, over the"));
+  CHECK(read_depth_map(dir / "map.png", false).cols == 64);
 }
