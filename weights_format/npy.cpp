@@ -156,8 +156,10 @@ class HeaderParser {
     if (peek() < '0' || peek() > '9') bad("expected a non-negative integer");
     int64_t v = 0;
     for (; peek() >= '0' && peek() <= '9'; ++pos_) {
-      v = v * 10 + (peek() - '0');
-      if (v > kLargest) bad("dimension too large");
+      const int digit = peek() - '0';
+      // Checked before multiplying: v * 10 itself must not overflow.
+      if (v > (kLargest - digit) / 10) bad("dimension too large");
+      v = v * 10 + digit;
     }
     return v;
   }

@@ -129,6 +129,10 @@ TEST_CASE("npy: damaged files give distinct one-line errors") {
   check_error(error_of(replaced(good, "False", "Fals ")), "expected True or False");
   check_error(error_of(replaced(good, "(2, 3, 4)", "(2, 3,-4)")), "expected a non-negative integer");
   check_error(error_of(replaced(good, "(2, 3, 4)", "(24)     ")), "needs a trailing comma");
+  // Found by fuzz_npy (fuzz/corpus/npy/crash-dimension-overflow): 20 digits overflowed
+  // int64 while being parsed (undefined behaviour) before the size check saw them.
+  check_error(error_of(replaced(good, "(2, 3, 4), }              ", "(99999999999999999999,), }")),
+              "dimension too large");
   check_error(error_of(replaced(good, "'<f4', ", "'<f4'  ")), "expected ','");
   check_error(error_of(replaced(good, "'<f4'", "'<i2'")), "unsupported dtype '<i2'");
   std::vector<uint8_t> no_newline = good;
