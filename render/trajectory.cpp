@@ -116,8 +116,13 @@ Keyframe read_keyframe(const cv::FileNode& node, const std::string& path, int in
   if (node["time"].empty()) fail(path, where + " has no \"time\"");
   k.time = read_number(node["time"], path, where + " \"time\"");
   if (!node["t"].empty()) k.pose.t = read_vec3(node["t"], path, where + " \"t\"");
-  if (!node["rotation"].empty())
-    k.pose.R = rotation_from_degrees(read_vec3(node["rotation"], path, where + " \"rotation\""));
+  if (!node["rotation"].empty()) {
+    const cv::Vec3d degrees = read_vec3(node["rotation"], path, where + " \"rotation\"");
+    // Beyond a turn an angle says nothing new, and a huge one has no finite sine.
+    for (int i = 0; i < 3; ++i)
+      if (std::abs(degrees[i]) > 360) fail(path, where + " \"rotation\" angles must be within [-360, 360] degrees");
+    k.pose.R = rotation_from_degrees(degrees);
+  }
   if (!node["zoom"].empty()) {
     k.pose.zoom = read_number(node["zoom"], path, where + " \"zoom\"");
     if (!(k.pose.zoom > 0)) fail(path, where + " \"zoom\" must be positive");

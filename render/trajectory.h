@@ -51,9 +51,9 @@ struct Keyframe {
 // Reads a JSON keyframe file (OpenCV FileStorage):
 //   {"keyframes": [{"time": 0, "t": [0, 0, 0], "rotation": [0, 0, 0], "zoom": 1}, ...]}
 // "t" is the pose's translation (X_new = R X + t, scene units: those of the plane depths),
-// "rotation" degrees about x, y, z (see rotation_from_degrees), "zoom" the focal length
-// factor; all three are optional (identity). Throws std::runtime_error with one line
-// naming the file and the problem.
+// "rotation" degrees about x, y, z, each within [-360, 360] (see rotation_from_degrees),
+// "zoom" the focal length factor; all three are optional (identity). Throws
+// std::runtime_error with one line naming the file and the problem.
 std::vector<Keyframe> read_keyframes(const std::string& path);
 
 // Frames at `fps` from the first keyframe's time to the last's: translation and zoom

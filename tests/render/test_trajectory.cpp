@@ -180,6 +180,9 @@ TEST_CASE("malformed keyframe files are refused with one line naming the file") 
       {"{\"keyframes\": [ {\"time\": 0, \"t\": [1, 2]} ]}", "keyframe 0 \"t\" must be a list of 3 numbers"},
       {"{\"keyframes\": [ {\"time\": 0, \"rotation\": [1, \"a\", 2]} ]}", "keyframe 0 \"rotation\" must be a number"},
       {"{\"keyframes\": [ {\"time\": 0, \"zoom\": -1} ]}", "\"zoom\" must be positive"},
+      // Found by fuzz_keyframes (fuzz/corpus/keyframes/crash-huge-rotation): an angle of
+      // 1e308 degrees made a rotation matrix of NaN.
+      {"{\"keyframes\": [ {\"time\": 0, \"rotation\": [2, -3, 1e308]} ]}", "angles must be within [-360, 360]"},
       {"{\"keyframes\": [ {\"time\": 1}, {\"time\": 1} ]}", "keyframe 1 \"time\" must be later"},
   };
   int index = 0;
