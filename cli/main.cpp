@@ -3,6 +3,7 @@
 #include <cstdio>
 #include <cstring>
 #include <exception>
+#include <new>
 #include <string>
 
 #include "cli/commands.h"
@@ -44,6 +45,11 @@ int main(int argc, char** argv) {
     if (std::strcmp(argv[1], c.name) != 0) continue;
     try {
       return c.run(argc - 1, argv + 1);
+    } catch (const std::bad_alloc&) {
+      // What got past the memory-budget checks (engine/memory_budget.h) before allocating.
+      std::fprintf(stderr, "ampi %s: out of memory (less was free than the memory budget, AMPI_MEMORY_BUDGET, allowed)\n",
+                   c.name);
+      return 1;
     } catch (const std::exception& e) {
       std::fprintf(stderr, "ampi %s: %s\n", c.name, e.what());
       return 1;
