@@ -11,6 +11,7 @@ packages=(
   python3-pil                               # JPEG decoding for training/scenes.py textures
   g++-aarch64-linux-gnu qemu-user           # aarch64 cross build, tests run under qemu
   ffmpeg                                    # GIF output (palette) and H.264 through OpenCV
+  clang libclang-rt-14-dev                  # libFuzzer targets (fuzz/, scripts/test_reliability.sh)
   chromium                                  # headless screenshots of viewer.html in the tests
 )
 

@@ -19,3 +19,6 @@ cmake -S . -B build-aarch64 -DCMAKE_BUILD_TYPE=Release \
 cmake --build build-aarch64 -j"$jobs"
 AMPI_TEST_SMALL=1 ctest --test-dir build-aarch64 --output-on-failure --no-tests=error \
   -R '^(engine|kernels|weights_format|nets)$' -j"$jobs"
+
+# Sanitizers (ASan+UBSan, TSan) and bounded libFuzzer runs of every parser: RELIABILITY.md.
+bash scripts/test_reliability.sh
