@@ -164,6 +164,9 @@ def load_or_init(args, g, d, opt_g, opt_d, log):
     d.load_state_dict(ck["discriminator"])
     opt_g.load_state_dict(ck["opt_g"])
     opt_d.load_state_dict(ck["opt_d"])
+    for opt, lr in ((opt_g, args.lr_g), (opt_d, args.lr_d)):  # the command line wins
+        for group in opt.param_groups:
+            group["lr"] = lr
     torch.set_rng_state(ck["torch_rng"])
     rng = np.random.default_rng()
     rng.bit_generator.state = ck["numpy_rng"]
@@ -190,6 +193,8 @@ def parse_args(argv):
     ap.add_argument("--disparity-dir", default=data.DEFAULT_DISPARITY_DIR)
     ap.add_argument("--run-dir", default=os.path.join(os.path.dirname(__file__), "runs", "inpaint"))
     ap.add_argument("--perceptual", default=None, help="depth network checkpoint for L_perc")
+    ap.add_argument("--lr-g", type=float, default=LR_G, help="generator learning rate (paper: 2e-4)")
+    ap.add_argument("--lr-d", type=float, default=LR_D, help="discriminator learning rate (paper: 1e-4)")
     ap.add_argument("--steps", type=int, default=1_000_000, help="stop after this many steps")
     ap.add_argument("--batch", type=int, default=6)
     ap.add_argument("--crop", type=int, default=128)
@@ -222,8 +227,8 @@ def main(argv=None):
     g, d = InpaintGenerator(), PatchDiscriminator()
     phi = PerceptualFeatures(args.perceptual)
     log(f"perceptual features: depth encoder, {phi.source}")
-    opt_g = torch.optim.Adam(g.parameters(), lr=LR_G, betas=BETAS)
-    opt_d = torch.optim.Adam(d.parameters(), lr=LR_D, betas=BETAS)
+    opt_g = torch.optim.Adam(g.parameters(), lr=args.lr_g, betas=BETAS)
+    opt_d = torch.optim.Adam(d.parameters(), lr=args.lr_d, betas=BETAS)
     step, best, rng = load_or_init(args, g, d, opt_g, opt_d, log)
 
     log_path = os.path.join(args.run_dir, "log.csv")
