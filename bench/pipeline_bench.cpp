@@ -41,7 +41,7 @@ const char kUsage[] =
     "  --runs N       runs per size (default 3)\n"
     "  --threads N    worker threads (default 2)\n"
     "  --frames N     video frames rendered and encoded per run (default 30)\n"
-    "  --classic-inpainting  push-pull instead of the inpainting network\n"
+    "  --network-inpainting  the inpainting network instead of push-pull\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
 double peak_rss_mb() {
@@ -108,7 +108,7 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
      << "to each size, " << threads << " threads, median of " << runs << " runs after a warm-up run;\n"
      << "the video is " << frames << " frames. Peak memory is the process's maximum resident\n"
      << "set after all runs at that size (sizes run smallest first, so each includes the\n"
-     << "ones before). Inpainting: " << (options.classic_inpainting ? "push-pull" : "the network")
+     << "ones before). Inpainting: " << (options.network_inpainting ? "the network" : "push-pull")
      << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"
      << "| stage |";
   for (const SizeResult& r : results) md << " " << r.size.width << "x" << r.size.height << " (ms) |";
@@ -157,7 +157,7 @@ int pipeline_benchmark(int argc, char** argv) {
   p.option("--threads", &threads, 1, 256);
   p.option("--frames", &frames, 1, 10000);
   p.option("--out", &out);
-  p.flag("--classic-inpainting", &options.classic_inpainting);
+  p.flag("--network-inpainting", &options.network_inpainting);
   if (!p.parse(argc, argv)) return 0;
   set_default_threads(threads);
 

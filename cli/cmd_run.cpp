@@ -49,8 +49,8 @@ const char kUsage[] =
     "  --max-planes N          at most N planes (default 8)\n"
     "  --uniform               equal disparity intervals (the paper's baseline)\n"
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
-    "  --inpaint-weights FILE  inpainting network weight file instead of the bundled one\n"
-    "  --classic-inpainting    fill occluded margins by push-pull instead of the network\n"
+    "  --inpainter NAME        push-pull (default) or network: what fills occluded margins\n"
+    "  --inpaint-weights FILE  inpainting network weight file (implies --inpainter network)\n"
     "  --fov DEG               assumed horizontal field of view (default 60)\n"
     "  --trajectory NAME       circle, swing, zoom-in or dolly-zoom (default circle)\n"
     "  --keyframes FILE        a JSON keyframe file instead of --trajectory\n"
@@ -96,7 +96,11 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.flag("--uniform", &a.mpi.uniform);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
-  p.flag("--classic-inpainting", &a.mpi.classic_inpainting);
+  p.option("--inpainter", [&](const std::string& v) {
+    if (v != "push-pull" && v != "network")
+      throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
+    a.mpi.network_inpainting = v == "network";
+  });
   p.option("--fov", &a.mpi.fov_degrees, 1, 179);
   PathOptions& path = a.video_options.path;
   p.option("--trajectory", [&](const std::string& v) { path.kind = parse_path_kind(v); });

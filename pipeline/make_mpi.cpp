@@ -16,15 +16,6 @@ namespace ampi {
 
 namespace {
 
-// The bundled inpainting weights, or "" when this installation has none.
-std::string bundled_inpaint_weights() {
-  try {
-    return find_weights("inpaint.ampw");
-  } catch (const std::runtime_error&) {
-    return "";
-  }
-}
-
 // The margin to fill scales with the photo: the paper's 40 px are at about 1024 px.
 OcclusionMaskParams margin_for(const cv::Size& size) {
   OcclusionMaskParams params;
@@ -67,12 +58,12 @@ cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, const std::string& photo
 
 LayerFiller& MpiMaker::filler() {
   if (filler_) return *filler_;
-  const std::string path =
-      options_.inpaint_weights.empty() ? bundled_inpaint_weights() : options_.inpaint_weights;
-  if (path.empty() || options_.classic_inpainting) {
+  if (!options_.network_inpainting && options_.inpaint_weights.empty()) {
     filler_ = push_pull_filler();
     inpainter_ = "push-pull";
   } else {
+    const std::string path = options_.inpaint_weights.empty() ? find_weights("inpaint.ampw")
+                                                               : options_.inpaint_weights;
     filler_ = inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(path)));
     inpainter_ = "network";
   }
