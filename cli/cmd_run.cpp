@@ -60,6 +60,8 @@ const char kUsage[] =
     "  --boomerang, --one-way  back and forth, or once (default: by trajectory)\n"
     "  --stereo MODE           mono, sbs (side by side) or anaglyph (red-cyan) (default mono)\n"
     "  --video-format F        mp4, gif (needs ffmpeg) or png (a PNG sequence) (default mp4)\n"
+    "  --no-overscan           keep the full frame (its edges show black where the camera\n"
+    "                          looks past the photo) instead of zooming in just enough\n"
     "  --no-video              skip the video\n"
     "  --threads N             worker threads (default: all cores)\n"
     "  --quiet                 no progress on stderr\n";
@@ -113,6 +115,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--stereo", [&](const std::string& v) { a.video_options.stereo = parse_stereo_mode(v); });
   p.option("--video-format",
            [&](const std::string& v) { a.video_options.container = parse_video_format(v); });
+  p.flag("--no-overscan", [&] { a.video_options.overscan = false; });
   bool no_video = false;
   p.flag("--no-video", &no_video);
   help = !p.parse(argc, argv);

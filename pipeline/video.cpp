@@ -1,5 +1,6 @@
 #include "pipeline/video.h"
 
+#include <algorithm>
 #include <stdexcept>
 
 #include "render/renderer.h"
@@ -29,15 +30,42 @@ std::string video_file_name(Container container) {
   return "video";
 }
 
+double overscan_zoom(const Mpi& mpi, const std::vector<Pose>& poses) {
+  const Camera& c = mpi.camera;
+  const double w = c.width - 1, h = c.height - 1;
+  double zoom = 1;
+  for (const Pose& pose : poses) {
+    const cv::Matx33d H = plane_homography(c, pose, mpi.planes.back().depth);
+    auto map = [&](double x, double y) {
+      const cv::Vec3d p = H * cv::Vec3d(x, y, 1);
+      return cv::Point2d(p[0] / p[2], p[1] / p[2]);
+    };
+    const cv::Point2d tl = map(0, 0), tr = map(w, 0), bl = map(0, h), br = map(w, h);
+    // Where each edge of the photo lands, taking the side that uncovers most; zooming by
+    // f about the principal point moves a point x to cx + f (x - cx).
+    const double left = std::max(tl.x, bl.x), right = std::min(tr.x, br.x);
+    const double top = std::max(tl.y, tr.y), bottom = std::min(bl.y, br.y);
+    if (left > 0 && left < c.cx) zoom = std::max(zoom, c.cx / (c.cx - left));
+    if (right < w && right > c.cx) zoom = std::max(zoom, (w - c.cx) / (right - c.cx));
+    if (top > 0 && top < c.cy) zoom = std::max(zoom, c.cy / (c.cy - top));
+    if (bottom < h && bottom > c.cy) zoom = std::max(zoom, (h - c.cy) / (bottom - c.cy));
+  }
+  return zoom;
+}
+
 int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
                 bool overwrite, ThreadPool& pool) {
-  const std::vector<Pose> poses =
+  std::vector<Pose> poses =
       options.keyframes.empty()
           ? camera_path(options.path, mpi.planes)
           : keyframe_path(read_keyframes(options.keyframes), options.path.fps);
   // Eyes 6% of the nearest plane's distance apart: a comfortable stereo budget whatever
   // the scene's scale.
   const double baseline = options.baseline > 0 ? options.baseline : 0.06 * mpi.planes.back().depth;
+  if (options.overscan) {
+    const double zoom = overscan_zoom(mpi, poses);
+    for (Pose& pose : poses) pose.zoom *= zoom;
+  }
   const Renderer renderer(mpi);
   FrameWriter writer(path, options.container, options.path.fps, overwrite);
   render_frames(renderer, poses, options.stereo, baseline, writer, pool);

@@ -17,7 +17,14 @@ struct VideoOptions {
   StereoMode stereo = StereoMode::Mono;
   double baseline = 0;        // between the eyes, scene units; 0: 6% of the nearest depth
   Container container = Container::Mp4;
+  // Zoom in just enough that the nearest layer never uncovers the frame's edges (nothing
+  // exists beyond the photo, so they would show black): the usual crop of 3D photos.
+  bool overscan = true;
 };
+
+// The smallest zoom factor (>= 1) at which the nearest plane, seen from every pose,
+// still covers the whole frame.
+double overscan_zoom(const Mpi& mpi, const std::vector<Pose>& poses);
 
 // "mp4", "gif", "png" (a PNG sequence); throws std::invalid_argument otherwise.
 Container parse_video_format(const std::string& name);
