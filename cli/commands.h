@@ -4,6 +4,7 @@
 
 namespace ampi::cli {
 
+int cmd_run(int argc, char** argv);
 int cmd_info(int argc, char** argv);
 int cmd_bench(int argc, char** argv);
 int cmd_slice(int argc, char** argv);

@@ -17,6 +17,7 @@ struct Command {
 };
 
 const Command kCommands[] = {
+    {"run", ampi::cli::cmd_run, "photo(s) to 3D photo: depth, MPI, video, viewer"},
     {"info", ampi::cli::cmd_info, "print a weight file's metadata and tensor table"},
     {"bench", ampi::cli::cmd_bench, "kernel, network, renderer and pipeline latency"},
     {"slice", ampi::cli::cmd_slice, "cut a depth map into planes (adaptive or uniform), print JSON"},
