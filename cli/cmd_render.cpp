@@ -15,6 +15,7 @@
 #include "cli/commands.h"
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
+#include "pipeline/video.h"
 #include "render/render_frames.h"
 #include "render/renderer.h"
 #include "render/trajectory.h"
@@ -53,6 +54,8 @@ const char kUsage[] =
     "  --focus-plane J     dolly-zoom: the plane (0 = farthest) that keeps its size (default nearest)\n"
     "  --fov DEG           render with this horizontal field of view instead of the MPI's camera\n"
     "  --threads N         worker threads (default: all hardware threads)\n"
+    "  --no-overscan       keep the full frame along a path (by default it zooms in just\n"
+    "                      enough that the camera never looks past the photo's edges)\n"
     "  --force             replace OUT if it exists\n";
 
 struct RenderOptions {
@@ -60,6 +63,7 @@ struct RenderOptions {
   std::optional<cv::Vec3d> pose;
   PathOptions path;
   bool trajectory_given = false, boomerang = false, one_way = false, force = false;
+  bool overscan = true;
   double baseline = 0.03, fov = 0;
   int threads = 0;
 };
@@ -98,6 +102,7 @@ std::optional<RenderOptions> parse(int argc, char** argv) {
   p.option("--fov", &o.fov, 1, 179);
   p.option("--threads", &o.threads, 1, 1024);
   p.flag("--force", &o.force);
+  p.flag("--no-overscan", [&] { o.overscan = false; });
   if (!p.parse(argc, argv)) return std::nullopt;
   if (positionals.size() != 1) throw std::runtime_error("expected one MPI_DIR (see ampi render --help)");
   o.mpi_dir = positionals[0];
@@ -197,7 +202,11 @@ int cmd_render(int argc, char** argv) {
   if (o.fov > 0) mpi.camera = camera_from_fov(mpi.camera.width, mpi.camera.height, o.fov);
   if (kind.viewer) return write_viewer_page(o, mpi);
 
-  const std::vector<Pose> poses = poses_for(o, mpi);
+  std::vector<Pose> poses = poses_for(o, mpi);
+  if (!o.pose && o.overscan) {  // a path, not one exact pose: hide the photo's edges
+    const double zoom = overscan_zoom(mpi, poses);
+    for (Pose& pose : poses) pose.zoom *= zoom;
+  }
   FrameWriter writer(o.output, kind.container, o.path.fps, o.force);
   if (o.threads > 0) set_default_threads(o.threads);
   const Renderer renderer(mpi);

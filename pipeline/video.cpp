@@ -59,9 +59,8 @@ int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& 
       options.keyframes.empty()
           ? camera_path(options.path, mpi.planes)
           : keyframe_path(read_keyframes(options.keyframes), options.path.fps);
-  // Eyes 6% of the nearest plane's distance apart: a comfortable stereo budget whatever
-  // the scene's scale.
-  const double baseline = options.baseline > 0 ? options.baseline : 0.06 * mpi.planes.back().depth;
+  // Relative to the nearest plane, so the stereo budget is the same whatever the scale.
+  const double baseline = options.baseline * mpi.planes.back().depth;
   if (options.overscan) {
     const double zoom = overscan_zoom(mpi, poses);
     for (Pose& pose : poses) pose.zoom *= zoom;

@@ -15,7 +15,7 @@ struct VideoOptions {
   PathOptions path;           // the named move, frames, fps, amplitude, boomerang
   std::string keyframes;      // a keyframe file instead of the named move
   StereoMode stereo = StereoMode::Mono;
-  double baseline = 0;        // between the eyes, scene units; 0: 6% of the nearest depth
+  double baseline = 0.03;     // between the eyes, as a fraction of the nearest plane's depth
   Container container = Container::Mp4;
   // Zoom in just enough that the nearest layer never uncovers the frame's edges (nothing
   // exists beyond the photo, so they would show black): the usual crop of 3D photos.
