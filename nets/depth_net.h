@@ -44,6 +44,7 @@ class DepthNet {
 
   // rgb: [h][w][3] floats in [0, 1] (the file's normalisation is applied here).
   // Returns the disparity, an f32 tensor of shape {h, w} (relative; larger = nearer).
+  // One run at a time per DepthNet: the plan and its arena are reused between runs.
   Tensor run(const float* rgb, int h, int w, ThreadPool& pool = default_pool());
 
   const std::string& variant() const;  // "lite", "heavy", ... as the file names it

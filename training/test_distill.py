@@ -57,10 +57,9 @@ class PseudoGroundTruth(unittest.TestCase):
         self.assertAlmostEqual(float(label.max()), 1.0, places=6)
 
     def test_mirrored_predictions_are_flipped_back(self):
-        # A teacher that ignores its input and always says "the left is near": flipping
-        # back the mirrored run makes half the ensemble say "the right is near", and the
-        # median of an even split is flat. A builder that forgot to flip back would
-        # instead reproduce the ramp.
+        # A teacher that ignores its input and always says "the left is near": its
+        # prediction on a mirrored photo, flipped back, must say "the right is near".
+        # A builder that forgot to flip back would store the same ramp twice.
         def left_is_near(rgb):
             return np.tile(np.linspace(1.0, 0.0, rgb.shape[1], dtype=np.float32), (rgb.shape[0], 1))
 
