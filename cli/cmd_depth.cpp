@@ -30,12 +30,13 @@ const char kUsage[] =
     "  --model M         lite (default, faster) or heavy (more accurate)\n"
     "  --weights FILE    a depth weight file instead of the bundled weights/depth_M.ampw\n"
     "                    (found via $AMPI_WEIGHTS_DIR or weights/ beside the program)\n"
-    "  --max-size N      working resolution: long side in pixels (default 1024)\n"
+    "  --max-size N      working resolution: long side in pixels (default: what the\n"
+    "                    weight file asks for, depth.working_long_side, else 1024)\n"
     "  --threads N       worker threads (default: all hardware threads)\n";
 
 struct DepthOptions {
   std::string photo, output, model = "lite", weights;
-  int max_size = 1024;
+  int max_size = 0;  // 0: the weight file's working_long_side
   int threads = 0;
 };
 
@@ -99,13 +100,14 @@ int cmd_depth(int argc, char** argv) {
   const DepthOptions o = parse(argc, argv);
   const std::string weights = o.weights.empty() ? find_weights("depth_" + o.model + ".ampw") : o.weights;
   DepthNet net = DepthNet::load(weights);
+  const int max_size = o.max_size ? o.max_size : net.working_long_side();
   const cv::Mat photo = read_photo(o.photo);
   ThreadPool pool(o.threads);
   const auto start = std::chrono::steady_clock::now();
-  const cv::Mat disparity = disparity_at_photo_size(net, photo, o.max_size, pool);
+  const cv::Mat disparity = disparity_at_photo_size(net, photo, max_size, pool);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_depth_png16(disparity, o.output);
-  const ImageSize work = depth_working_size(photo.rows, photo.cols, o.max_size);
+  const ImageSize work = depth_working_size(photo.rows, photo.cols, max_size);
   std::printf("%s: %dx%d disparity (%s network at %dx%d, %.2f s) -> %s\n", o.photo.c_str(), photo.cols,
               photo.rows, net.variant().c_str(), work.width, work.height, seconds, o.output.c_str());
   return 0;

@@ -17,6 +17,7 @@ constexpr const char* kArchName = "ampi.depth.dwt-mobilenetv3";
 constexpr int64_t kFormatVersion = 1;
 constexpr int kFieldsPerBlock = 6;  // kind, out, expanded, kernel, se_reduced, activation
 constexpr int kMaxLevels = 8;
+constexpr int kDefaultWorkingLongSide = 1024;
 
 enum class BlockKind { Conv = 0, MobileNetV3 = 1 };
 
@@ -192,6 +193,7 @@ ImageSize depth_working_size(int height, int width, int max_side) {
 struct DepthNet::Impl {
   std::string variant;
   int levels = 0;
+  int working_long_side = kDefaultWorkingLongSide;
   float mean[3], inv_std[3];
   std::vector<Stage> encoder, decoder;  // decoder[l] works at level l + 1
   Conv2d head;                          // on decoder level 1: the Haar coefficients of the output
@@ -222,6 +224,13 @@ DepthNet DepthNet::load(const std::string& path, const KernelTable& table) {
   impl->levels = int(levels);
   if (f.get_int("depth.multiple") != impl->multiple())
     fail(f, "depth.multiple disagrees with 2^depth.levels");
+  if (f.has("depth.working_long_side")) {
+    const int64_t side = f.get_int("depth.working_long_side");
+    if (side < impl->multiple() || side > 16384)
+      fail(f, "depth.working_long_side " + std::to_string(side) + " is not in " +
+                  std::to_string(impl->multiple()) + "..16384");
+    impl->working_long_side = int(side);
+  }
   const std::vector<double> mean = f.get_floats("depth.input_mean"), stdev = f.get_floats("depth.input_std");
   if (mean.size() != 3 || stdev.size() != 3) fail(f, "depth.input_mean and depth.input_std need 3 values");
   for (int c = 0; c < 3; ++c) {
@@ -377,6 +386,7 @@ DepthNet::~DepthNet() = default;
 
 const std::string& DepthNet::variant() const { return impl_->variant; }
 int DepthNet::multiple() const { return impl_->multiple(); }
+int DepthNet::working_long_side() const { return impl_->working_long_side; }
 int64_t DepthNet::parameter_count() const { return impl_->params; }
 size_t DepthNet::arena_bytes() const { return impl_->plan ? impl_->plan->arena_bytes() : 0; }
 

@@ -49,6 +49,9 @@ class DepthNet {
 
   const std::string& variant() const;  // "lite", "heavy", ... as the file names it
   int multiple() const;                // the padding granularity (2^levels)
+  // The long side the weights work best at (metadata depth.working_long_side: weights
+  // trained on small images ask for a smaller working resolution); 1024 when absent.
+  int working_long_side() const;
   int64_t parameter_count() const;     // weights and biases the inference graph uses
   // Bytes of the activation arena of the last run (0 before the first).
   size_t arena_bytes() const;

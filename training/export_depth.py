@@ -8,7 +8,7 @@ What the file holds (nets/ARCHITECTURE.md describes the graph these rebuild):
     f32; squeeze-excite layers as 2-D matrices fc1 [reduced][channels], fc2 [channels][reduced];
   - metadata: the architecture name and every hyper-parameter the C++ builder needs
     (levels, the block list of each encoder and decoder level, head kernel, input
-    multiple), the input normalisation, the format version, and where the weights come
+    multiple), the input normalisation, the working resolution the weights suit, the format version, and where the weights come
     from (the git commit of the training code, steps, data).
 
 Tensor names: enc{L}.{i}.{part} and dec{L}.{i}.{part} with levels L counted from 1 (half
@@ -87,7 +87,7 @@ def git_commit() -> str:
         return "unknown"
 
 
-def export(model: depth_model.DepthNet, path: str, provenance: dict):
+def export(model: depth_model.DepthNet, path: str, provenance: dict, working_long_side: int = 1024):
     model.eval()
     arch = model.arch
     tensors = {}
@@ -99,6 +99,7 @@ def export(model: depth_model.DepthNet, path: str, provenance: dict):
         "depth.multiple": model.multiple,
         "depth.outputs": depth_model.NUM_OUTPUTS,
         "depth.head_kernel": arch["head_kernel"],
+        "depth.working_long_side": int(working_long_side),
         "depth.block_fields": "kind(0 conv, 1 mobilenetv3), out, expanded, kernel, se_reduced(0 none), "
                               "act(0 none, 1 relu, 2 hardswish)",
         "depth.input": "RGB in [0, 1], x' = (x - mean) / std per channel; H, W multiples of depth.multiple",
@@ -189,10 +190,14 @@ def main(argv=None):
     p.add_argument("checkpoint", help="train_depth.py checkpoint.pt")
     p.add_argument("output", help="the .ampw file to write")
     p.add_argument("--data", default="", help="what the network was trained on (recorded in the metadata)")
+    p.add_argument("--working-long-side", type=int, default=1024,
+                   help="the long side inference should run at by default (a network trained on small "
+                        "images generalises to a few times its training size, not to any)")
     args = p.parse_args(argv)
     model, ckpt = load_checkpoint(args.checkpoint)
     meta = export(model, args.output, {"steps": int(ckpt["step"]), "data": args.data,
-                                       "best_val_loss": float(ckpt["best_val"])})
+                                       "best_val_loss": float(ckpt["best_val"])},
+                  args.working_long_side)
     size = Path(args.output).stat().st_size
     print(f"{args.output}: {meta['depth.variant']}, {meta['depth.parameters']} parameters, "
           f"{size / 1e6:.2f} MB, step {ckpt['step']}")
