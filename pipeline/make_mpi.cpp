@@ -27,7 +27,7 @@ OcclusionMaskParams margin_for(const cv::Size& size) {
 }  // namespace
 
 MpiMaker::MpiMaker(MpiOptions options) : options_(std::move(options)) {
-  if (options_.working_size < kMinPhotoSide)
+  if (options_.working_size != 0 && options_.working_size < kMinPhotoSide)
     throw std::invalid_argument("working size must be at least " + std::to_string(kMinPhotoSide) + " px");
 }
 
@@ -52,7 +52,8 @@ cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, const std::string& photo
     depth_net_.emplace(progress.stage("load depth", [&] { return DepthNet::load(path); }));
   }
   return progress.stage("depth", [&] {
-    return estimate_disparity(*depth_net_, bgr, options_.working_size);
+    const int side = options_.working_size ? options_.working_size : depth_net_->working_long_side();
+    return estimate_disparity(*depth_net_, bgr, side);
   });
 }
 
@@ -83,7 +84,8 @@ MpiResult MpiMaker::make(const cv::Mat& bgr, const std::string& photo_path, Prog
   // layers at the photo's own resolution.
   std::vector<Plane> planes = progress.stage("slicing", [&] {
     cv::Mat small = disparity;
-    const ImageSize work = depth_working_size(disparity.rows, disparity.cols, options_.working_size);
+    const ImageSize work = depth_working_size(disparity.rows, disparity.cols,
+                                              options_.working_size ? options_.working_size : 1024);
     if (work.width != disparity.cols || work.height != disparity.rows)
       cv::resize(disparity, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
     return options_.uniform

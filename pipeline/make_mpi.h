@@ -19,7 +19,9 @@ struct MpiOptions {
   std::string depth_weights;         // a weight file instead of the bundled one
   std::string depth_file;            // the user's own depth map instead of the network
   bool depth_is_distance = false;    // depth_file holds distances (larger = farther)
-  int working_size = 1024;           // long side the network and the slicer run at
+  // Long side the depth network runs at; 0: what the weight file asks for
+  // (depth.working_long_side). The slicer runs at this size too, at most 1024.
+  int working_size = 0;
   bool uniform = false;              // the paper's baseline instead of adaptive slicing
   SlicingParams slicing;             // max_planes, the paper's constants, depth range
   double soft_alpha = 0;             // alpha ramp across plane cuts (0 = the paper)
