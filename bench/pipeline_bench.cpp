@@ -30,7 +30,8 @@ namespace ampi::bench {
 namespace {
 
 const char kUsage[] =
-    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N] [--out FILE]\n"
+    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
+    "                           [--network-inpainting] [--working-size N] [--out FILE]\n"
     "\n"
     "Times every stage of `ampi run` (decode, depth, slicing, assembly, inpainting, MPI\n"
     "write, render + encode of the video) on PHOTO resized to 1024x768 and to 3840x2160,\n"
@@ -42,6 +43,7 @@ const char kUsage[] =
     "  --threads N    worker threads (default 2)\n"
     "  --frames N     video frames rendered and encoded per run (default 30)\n"
     "  --network-inpainting  the inpainting network instead of push-pull\n"
+    "  --working-size N      the depth network's long side (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
 double peak_rss_mb() {
@@ -109,6 +111,8 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
      << "the video is " << frames << " frames. Peak memory is the process's maximum resident\n"
      << "set after all runs at that size (sizes run smallest first, so each includes the\n"
      << "ones before). Inpainting: " << (options.network_inpainting ? "the network" : "push-pull")
+     << "; depth network's long side: "
+     << (options.working_size ? std::to_string(options.working_size) : std::string("the weight file's"))
      << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"
      << "| stage |";
   for (const SizeResult& r : results) md << " " << r.size.width << "x" << r.size.height << " (ms) |";
@@ -158,6 +162,7 @@ int pipeline_benchmark(int argc, char** argv) {
   p.option("--frames", &frames, 1, 10000);
   p.option("--out", &out);
   p.flag("--network-inpainting", &options.network_inpainting);
+  p.option("--working-size", &options.working_size, kMinPhotoSide, 16384);
   if (!p.parse(argc, argv)) return 0;
   set_default_threads(threads);
 
