@@ -6,8 +6,9 @@
 The paper's recipe: Adam at 1e-3, learning rate x0.2 when the validation loss plateaus,
 the loss of training/losses.py on all four outputs. Runs are resumable: the run folder
 holds `checkpoint.pt` (model, optimiser, scheduler, step, best validation loss), written
-atomically every --checkpoint-every steps, and `train.log`, one text line per logged step
-and per validation. Starting again with the same --run continues where it stopped.
+atomically every --checkpoint-every steps, `best.pt` (the weights of the best validation
+loss so far: what to export), and `train.log`, one text line per logged step and per
+validation (the loss and the paper's metrics, see aligned_metrics). Starting again with the same --run continues where it stopped.
 
 Data sources (--data), all yielding (rgb, disparity) pairs, rgb in [0, 1]:
   scenes       the procedural RGB-D generator of training/scenes.py (exact disparity)
@@ -138,31 +139,40 @@ def make_batch(source, first_index: int, batch: int, validation: bool, rng: rand
 
 # ---- metrics ------------------------------------------------------------------------------
 
-def aligned_delta1(pred: torch.Tensor, target: torch.Tensor) -> float:
-    """The paper's delta < 1.25 after median and standard-deviation alignment of the
-    prediction to the (normalised, strictly positive) target, averaged over the batch."""
-    scores = []
+METRIC_NAMES = ("delta1.25", "delta1.25^2", "delta1.25^3", "rmse", "rel")
+
+
+def aligned_metrics(pred: torch.Tensor, target: torch.Tensor) -> dict:
+    """The paper's depth metrics after median and standard-deviation alignment, averaged
+    over the batch. The target disparity is normalised per image as in the loss (min-max
+    to [0, 10]) and shifted by 1 so that it is strictly positive; the prediction is
+    aligned to it (same median, same standard deviation) and clamped to 1e-3. delta < t:
+    share of pixels with max(p / y, y / p) < t; RMSE and REL = mean |p - y| / y are in
+    the units of the normalised target [1, 11]."""
+    rows = []
     for p, t in zip(pred.flatten(1), losses.normalise_target(target).flatten(1) + 1.0):
         p = (p - p.median()) / p.std().clamp_min(1e-6) * t.std() + t.median()
         p = p.clamp_min(1e-3)
         ratio = torch.maximum(p / t, t / p)
-        scores.append(float((ratio < 1.25).float().mean()))
-    return float(np.mean(scores))
+        rows.append([float((ratio < 1.25 ** k).float().mean()) for k in (1, 2, 3)]
+                    + [float(((p - t) ** 2).mean().sqrt()), float(((p - t).abs() / t).mean())])
+    return dict(zip(METRIC_NAMES, np.mean(rows, axis=0).tolist()))
 
 
 @torch.no_grad()
 def validate(model, source, count: int, batch: int):
+    """(mean loss, mean metrics) over the fixed validation set."""
     model.eval()
-    total, delta, batches = 0.0, 0.0, 0
+    total, metrics, batches = 0.0, [], 0
     for first in range(0, count, batch):
         rgb, disp = make_batch(source, first, min(batch, count - first), True, random.Random(0))
         outputs = model(rgb)
         loss, _ = losses.depth_loss(outputs, disp)
         total += float(loss)
-        delta += aligned_delta1(outputs[-1], disp)
+        metrics.append(list(aligned_metrics(outputs[-1], disp).values()))
         batches += 1
     model.train()
-    return total / batches, delta / batches
+    return total / batches, dict(zip(METRIC_NAMES, np.mean(metrics, axis=0).tolist()))
 
 
 # ---- checkpoints --------------------------------------------------------------------------
@@ -237,10 +247,14 @@ def train(args):
             log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
                           f"lr {optimiser.param_groups[0]['lr']:.2e} {(time.time() - t0) / seen:.2f} s/step")
         if step % args.val_every == 0 or step == args.steps:
-            val_loss, delta1 = validate(model, source, val_count, args.batch)
+            val_loss, metrics = validate(model, source, val_count, args.batch)
             scheduler.step(val_loss)
-            best = min(best, val_loss)
-            log_line(run, f"val step {step} loss {val_loss:.4f} delta1.25 {delta1:.4f} best {best:.4f}")
+            if val_loss < best:  # the weights worth exporting, kept apart from the latest
+                best = val_loss
+                save_checkpoint(run / "best.pt", {"model_name": args.model, "model": model.state_dict(),
+                                                  "step": step, "val_loss": val_loss, "metrics": metrics})
+            shown = " ".join(f"{name} {value:.4f}" for name, value in metrics.items())
+            log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
         if step % args.checkpoint_every == 0 or step == args.steps:
             checkpoint()
     log_line(run, f"done at step {step}")
