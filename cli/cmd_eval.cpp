@@ -1,5 +1,6 @@
 // ampi eval MODE: reproduce the paper's evaluations on any folder of photos. One entry
-// per mode in kModes; each mode parses its own options.
+// per mode in kModes; each mode parses its own options and leaves the measuring to the
+// library (eval/, inpaint/eval_inpaint.h).
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -15,6 +16,8 @@
 #include "cli/args.h"
 #include "cli/commands.h"
 #include "engine/thread_pool.h"
+#include "eval/depth_eval.h"
+#include "eval/slicing_eval.h"
 #include "inpaint/eval_inpaint.h"
 #include "inpaint/inpaint_net.h"
 #include "nets/depth_net.h"
@@ -163,6 +166,241 @@ int eval_inpaint(int argc, char** argv) {
   return 0;
 }
 
+// ---- eval depth ------------------------------------------------------------------------------
+
+const char kDepthUsage[] =
+    "usage: ampi eval depth --images DIR --reference DIR [--model lite|heavy | --weights FILE]\n"
+    "                       [--reference-is-distance] [--working-size N] [--limit N] [--threads N]\n"
+    "\n"
+    "The paper's depth metrics (delta < 1.25, 1.25^2, 1.25^3, RMSE, REL; Luvizon et al.,\n"
+    "after Eigen et al. 2014) of the depth network on every photo under DIR (.jpg, .jpeg,\n"
+    ".png, recursively, sorted), one row per method: the network, and vertical-gradient,\n"
+    "a baseline whose disparity grows linearly from the top row to the bottom (the floor).\n"
+    "\n"
+    "The reference of DIR/sub/name.jpg is the one file --reference/sub/name.* in any format\n"
+    "`ampi run --depth` reads (8/16-bit PNG, float TIFF, .npy), larger = nearer unless\n"
+    "--reference-is-distance. The prediction is resized (bilinear) to the reference's size.\n"
+    "\n"
+    "How each image is scored, all in disparity (the quantity the network predicts):\n"
+    "  valid pixels: reference > 0 (0 = no measurement, e.g. the sky); NaN/inf is an error\n"
+    "  alignment:    a = (p - median(p)) * std(r) / std(p) + median(r) over the valid pixels\n"
+    "                (p prediction, r reference, std the population standard deviation),\n"
+    "                then a = max(a, min(r)) so every ratio is defined\n"
+    "  delta < T:    fraction of valid pixels with max(a/r, r/a) < T\n"
+    "  RMSE:         sqrt(mean((a - r)^2)), in the reference's units\n"
+    "  REL:          mean(|a - r| / r), the reference in the denominator\n"
+    "The folder's scores are the means of the images' scores.\n"
+    "\n"
+    "  --images DIR              photos\n"
+    "  --reference DIR           reference depth maps, same relative paths and names\n"
+    "  --reference-is-distance   the references hold distances (larger = farther); 0 = none\n"
+    "  --model M                 lite (default) or heavy: the bundled weights/depth_M.ampw\n"
+    "  --weights FILE            a depth weight file instead\n"
+    "  --working-size N          long side the network runs at (default: the weight file's)\n"
+    "  --limit N                 only the first N photos\n"
+    "  --threads N               worker threads (default: all hardware threads)\n";
+
+struct DepthEvalArgs {
+  std::string images, reference, model = "lite", weights;
+  bool reference_is_distance = false;
+  int working_size = 0, limit = 0, threads = 0;
+};
+
+void print_depth_row(const std::string& method, const DepthMetrics& m, int images) {
+  std::printf("%-20s %10.4f %12.4f %12.4f %10.4f %8.4f %7d\n", method.c_str(), m.delta1, m.delta2, m.delta3, m.rmse,
+              m.rel, images);
+}
+
+int eval_depth(int argc, char** argv) {
+  DepthEvalArgs a;
+  ArgParser p("ampi eval depth", kDepthUsage);
+  p.option("--images", &a.images);
+  p.option("--reference", &a.reference);
+  p.flag("--reference-is-distance", &a.reference_is_distance);
+  p.option("--model", [&](const std::string& v) {
+    if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
+    a.model = v;
+  });
+  p.option("--weights", &a.weights);
+  p.option("--working-size", &a.working_size, 16, 16384);
+  p.option("--limit", &a.limit, 0, 1 << 30);
+  p.option("--threads", &a.threads, 0, 1024);
+  if (!p.parse(argc, argv)) return 0;
+  if (a.images.empty() || a.reference.empty())
+    throw std::runtime_error("--images DIR and --reference DIR are required (see ampi eval depth --help)");
+  if (!fs::is_directory(a.reference)) throw std::runtime_error(a.reference + ": not a directory");
+  if (a.threads > 0) set_default_threads(a.threads);
+
+  std::vector<std::string> photos = list_images(a.images);
+  if (a.limit > 0 && size_t(a.limit) < photos.size()) photos.resize(a.limit);
+  // Every reference is looked up before the network runs: a missing one stops at once.
+  std::vector<std::string> references;
+  for (const std::string& photo : photos) references.push_back(find_depth_reference(photo, a.images, a.reference));
+  DepthNet net = DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+  const int side = a.working_size ? a.working_size : net.working_long_side();
+  DepthMetricsMean network, gradient;
+  for (size_t i = 0; i < photos.size(); ++i) {
+    const cv::Mat bgr = read_photo(photos[i]);
+    const DepthReference ref = read_depth_reference(references[i], a.reference_is_distance);
+    if (ref.disparity.size() != bgr.size())
+      std::fprintf(stderr, "note: %s is %dx%d but its reference %s is %dx%d: the prediction is resized to the reference\n",
+                   photos[i].c_str(), bgr.cols, bgr.rows, references[i].c_str(), ref.disparity.cols,
+                   ref.disparity.rows);
+    cv::Mat prediction;
+    cv::resize(estimate_disparity(net, bgr, side), prediction, ref.disparity.size(), 0, 0, cv::INTER_LINEAR);
+    const DepthMetrics m = depth_metrics(prediction, ref);
+    network.add(m);
+    gradient.add(depth_metrics(vertical_gradient_disparity(ref.disparity.size()), ref));
+    std::fprintf(stderr, "%s: delta<1.25 %.4f, RMSE %.4f, REL %.4f\n", photos[i].c_str(), m.delta1, m.rmse, m.rel);
+  }
+  std::printf("%-20s %10s %12s %12s %10s %8s %7s\n", "method", "d<1.25", "d<1.25^2", "d<1.25^3", "RMSE", "REL",
+              "images");
+  print_depth_row(a.weights.empty() ? a.model : fs::path(a.weights).filename().string(), network.mean(),
+                  network.count());
+  print_depth_row("vertical-gradient", gradient.mean(), gradient.count());
+  std::printf("(disparity aligned to each reference by median and standard deviation; RMSE in the reference's "
+              "units; see --help)\n");
+  return 0;
+}
+
+// ---- eval slicing ----------------------------------------------------------------------------
+
+const char kSlicingUsage[] =
+    "usage: ampi eval slicing --images DIR [--counts 4,8,16] [--reference-planes N] [--poses N]\n"
+    "                         [--amplitude A] [--max-size N] [--model lite|heavy | --weights FILE]\n"
+    "                         [--working-size N] [--inpainter push-pull|network] [--limit N] [--threads N]\n"
+    "\n"
+    "The paper's Table 3 (Luvizon et al., WACV 2021: adaptive against uniform slicing, SSIM and\n"
+    "PSNR of novel views) on every photo under DIR (.jpg, .jpeg, .png, recursively, sorted).\n"
+    "Photos have no second view, so, as the paper does for its own photos, views are compared\n"
+    "with those of a densely sampled MPI. Per photo (scaled down to --max-size) and per\n"
+    "maximum plane count N, three MPIs from the same depth (our network), the same slicing\n"
+    "depth range and the same inpainting:\n"
+    "  adaptive   the paper's adaptive slicing, at most N planes (it makes n)\n"
+    "  uniform    equal disparity intervals, n planes: the count adaptive made for the photo\n"
+    "             (empty intervals are dropped, so it may hold fewer)\n"
+    "  reference  equal disparity intervals, --reference-planes planes\n"
+    "Each is rendered at the same target poses: the camera on a circle in the image plane,\n"
+    "radius A times the nearest reference plane's depth (as ampi run's circle path).\n"
+    "SSIM (11x11 Gaussian window, sigma 1.5) and PSNR of the full frame against the\n"
+    "reference's frame, averaged over poses, then photos. One row per count and method;\n"
+    "planes = the mean count made.\n"
+    "\n"
+    "  --images DIR            photos\n"
+    "  --counts LIST           maximum plane counts, comma-separated (default 4,8,16)\n"
+    "  --reference-planes N    planes of the dense reference MPI (default 64)\n"
+    "  --poses N               target poses (default 8)\n"
+    "  --amplitude A           circle radius / nearest reference depth (default 0.05)\n"
+    "  --max-size N            photos are scaled down to this long side (default 512)\n"
+    "  --model M, --weights F  depth network: bundled lite (default) or heavy, or a file\n"
+    "  --working-size N        long side the network runs at (default: the weight file's)\n"
+    "  --inpainter I           push-pull (default, as ampi run) or network (weights/inpaint.ampw)\n"
+    "  --limit N               only the first N photos\n"
+    "  --threads N             worker threads (default: all hardware threads)\n";
+
+struct SlicingEvalArgs {
+  std::string images, model = "lite", weights, inpainter = "push-pull";
+  SlicingEvalOptions options;
+  int max_size = 512, working_size = 0, limit = 0, threads = 0;
+};
+
+std::vector<int> parse_counts(const std::string& list) {
+  std::vector<int> counts;
+  size_t start = 0;
+  while (start <= list.size()) {
+    const size_t comma = std::min(list.find(',', start), list.size());
+    const std::string item = list.substr(start, comma - start);
+    size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (item.empty() || used != item.size() || value < 1 || value > 255)
+      throw std::runtime_error("--counts: '" + item + "' is not a plane count in 1..255");
+    counts.push_back(value);
+    start = comma + 1;
+  }
+  return counts;
+}
+
+LayerFiller slicing_filler(const std::string& inpainter) {
+  if (inpainter == "push-pull") return push_pull_filler();
+  return inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(find_weights("inpaint.ampw"))));
+}
+
+void print_slicing_table(const std::vector<SlicingScore>& rows, const std::vector<int>& psnr_wins,
+                         const std::vector<int>& ssim_wins) {
+  std::printf("%-6s %-9s %7s %8s %8s\n", "count", "method", "planes", "SSIM", "PSNR");
+  for (const SlicingScore& s : rows)
+    std::printf("%-6d %-9s %7.2f %8.4f %8.3f\n", s.count, s.method.c_str(), s.planes, s.ssim, s.psnr);
+  bool all = true;
+  for (size_t i = 0; i + 1 < rows.size(); i += 2) {
+    const SlicingScore &uniform = rows[i], &adaptive = rows[i + 1];
+    const bool at_or_above = adaptive.ssim >= uniform.ssim && adaptive.psnr >= uniform.psnr;
+    all = all && at_or_above;
+    std::printf("count %d: adaptive %s uniform in mean SSIM and PSNR; above it on %d (SSIM) and %d (PSNR) of %d photos\n",
+                uniform.count, at_or_above ? "at or above" : "NOT at or above", ssim_wins[i / 2], psnr_wins[i / 2],
+                uniform.photos);
+  }
+  std::printf("adaptive >= uniform at every count: %s\n", all ? "yes" : "no");
+}
+
+int eval_slicing(int argc, char** argv) {
+  SlicingEvalArgs a;
+  ArgParser p("ampi eval slicing", kSlicingUsage);
+  p.option("--images", &a.images);
+  p.option("--counts", [&](const std::string& v) { a.options.counts = parse_counts(v); });
+  p.option("--reference-planes", &a.options.reference_planes, 2, 255);
+  p.option("--poses", &a.options.poses, 1, 1000);
+  p.option("--amplitude", &a.options.amplitude, 1e-6, 0.999);
+  p.option("--max-size", &a.max_size, 32, 16384);
+  p.option("--model", [&](const std::string& v) {
+    if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
+    a.model = v;
+  });
+  p.option("--weights", &a.weights);
+  p.option("--working-size", &a.working_size, 16, 16384);
+  p.option("--inpainter", [&](const std::string& v) {
+    if (v != "push-pull" && v != "network") throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
+    a.inpainter = v;
+  });
+  p.option("--limit", &a.limit, 0, 1 << 30);
+  p.option("--threads", &a.threads, 0, 1024);
+  if (!p.parse(argc, argv)) return 0;
+  if (a.images.empty()) throw std::runtime_error("--images DIR is required (see ampi eval slicing --help)");
+  if (a.threads > 0) set_default_threads(a.threads);
+
+  std::vector<std::string> photos = list_images(a.images);
+  if (a.limit > 0 && size_t(a.limit) < photos.size()) photos.resize(a.limit);
+  DepthNet net = DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+  const int side = a.working_size ? a.working_size : net.working_long_side();
+  SlicingEvaluator eval(a.options, slicing_filler(a.inpainter));
+  std::vector<int> psnr_wins(a.options.counts.size()), ssim_wins(a.options.counts.size());
+  for (const std::string& path : photos) {
+    const cv::Mat bgr = fit_long_side(read_photo(path), a.max_size);
+    cv::Mat disparity;
+    cv::resize(estimate_disparity(net, bgr, side), disparity, bgr.size(), 0, 0, cv::INTER_LINEAR);
+    const std::vector<SlicingScore> rows = eval.add(bgr, disparity);
+    std::string line;
+    for (size_t i = 0; i + 1 < rows.size(); i += 2) {
+      psnr_wins[i / 2] += rows[i + 1].psnr > rows[i].psnr;
+      ssim_wins[i / 2] += rows[i + 1].ssim > rows[i].ssim;
+      char part[160];
+      std::snprintf(part, sizeof part, "  %d: %.0f planes %.2f dB vs uniform %.0f planes %.2f dB", rows[i].count,
+                    rows[i + 1].planes, rows[i + 1].psnr, rows[i].planes, rows[i].psnr);
+      line += part;
+    }
+    std::fprintf(stderr, "%s:%s\n", path.c_str(), line.c_str());
+  }
+  print_slicing_table(eval.mean(), psnr_wins, ssim_wins);
+  std::printf("(%zu photos at most %d px, %d poses, amplitude %g, reference of %d planes, %s inpainting, %s depth)\n",
+              photos.size(), a.max_size, a.options.poses, a.options.amplitude, a.options.reference_planes,
+              a.inpainter.c_str(), a.weights.empty() ? a.model.c_str() : a.weights.c_str());
+  return 0;
+}
+
 // ---- the mode table ---------------------------------------------------------------------------
 
 struct Mode {
@@ -172,6 +410,8 @@ struct Mode {
 };
 
 const Mode kModes[] = {
+    {"depth", eval_depth, "depth metrics (delta, RMSE, REL) against reference maps, vs. a vertical gradient"},
+    {"slicing", eval_slicing, "the paper's Table 3: adaptive vs. uniform MPIs against a dense one (SSIM, PSNR)"},
     {"inpaint", eval_inpaint, "margin filling: ampi vs. cv::inpaint Telea / Navier-Stokes, push-pull"},
 };
 

@@ -1,0 +1,99 @@
+#!/bin/sh
+# ampi eval depth and ampi eval slicing through the program, on tiny folders made here.
+# A reference written by `ampi depth` with the same network is the network's own
+# prediction: eval depth must score it delta = 1 and an RMSE of 16-bit rounding only,
+# while the vertical-gradient baseline scores less. Missing and NaN references, bad
+# options: non-zero exit, one line on stderr naming the file or option, nothing on stdout.
+# A reference of another size: the prediction is resized to it, with a note.
+#   usage: eval_cli.sh AMPI_BINARY PHOTO
+set -u
+ampi=$1
+photo=$2
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+failures=0
+
+fail() {
+  echo "FAIL: $*" >&2
+  failures=$((failures + 1))
+}
+
+# expect_error NAME TEXT ARGS...: non-zero exit, nothing on stdout, one stderr line with TEXT.
+expect_error() {
+  name=$1 text=$2 before=$failures
+  shift 2
+  "$ampi" eval "$@" >"$tmp/out" 2>"$tmp/err" && fail "$name: exit status 0"
+  [ ! -s "$tmp/out" ] || fail "$name: wrote to stdout: $(head -c 200 "$tmp/out")"
+  lines=$(wc -l <"$tmp/err")
+  [ "$lines" -eq 1 ] || fail "$name: $lines lines on stderr: $(cat "$tmp/err")"
+  grep -qF -- "$text" "$tmp/err" || fail "$name: stderr lacks '$text': $(cat "$tmp/err")"
+  [ "$failures" -ne "$before" ] || echo "ok: $name -> $(cat "$tmp/err")"
+}
+
+# row FILE METHOD: the metrics row of METHOD in eval depth's table.
+row() { awk -v m="$2" '$1 == m' "$1"; }
+
+mkdir -p "$tmp/images/sub" "$tmp/ref/sub"
+cp "$photo" "$tmp/images/sub/a.jpg"
+"$ampi" depth "$tmp/images/sub/a.jpg" -o "$tmp/ref/sub/a.png" --model lite >/dev/null 2>&1 || fail "ampi depth failed"
+
+# The network against its own prediction.
+if "$ampi" eval depth --images "$tmp/images" --reference "$tmp/ref" --model lite --threads 2 \
+    >"$tmp/out" 2>"$tmp/err"; then
+  lite=$(row "$tmp/out" lite)
+  gradient=$(row "$tmp/out" vertical-gradient)
+  echo "$lite" | awk '{ exit !($2 == 1 && $3 == 1 && $4 == 1 && $5 < 1 && $6 < 0.01 && $7 == 1) }' ||
+    fail "lite against its own map: expected delta 1, RMSE < 1 (of 65535): $(cat "$tmp/out")"
+  echo "$gradient" | awk '{ exit !($2 < 1 && $5 > 100) }' ||
+    fail "vertical-gradient should score below the network's own map: $(cat "$tmp/out")"
+  [ "$failures" -eq 0 ] && echo "ok: eval depth, own prediction -> $lite"
+else
+  fail "eval depth: exit status $?: $(cat "$tmp/err")"
+fi
+
+# A reference of another size: a note, and the prediction resized to it.
+before=$failures
+mkdir -p "$tmp/small/images" "$tmp/small/ref"
+cp "$photo" "$tmp/small/images/b.jpg"
+/usr/bin/python3 -c "
+import numpy as np, sys
+y = np.linspace(0, 1, 40, dtype=np.float32)[:, None] * np.ones((1, 64), np.float32)
+np.save(sys.argv[1], 1 + y)" "$tmp/small/ref/b.npy"
+"$ampi" eval depth --images "$tmp/small/images" --reference "$tmp/small/ref" >"$tmp/out" 2>"$tmp/err" ||
+  fail "size mismatch: exit status $?: $(cat "$tmp/err")"
+grep -q "is 64x40: the prediction is resized to the reference" "$tmp/err" ||
+  fail "size mismatch: no note: $(cat "$tmp/err")"
+row "$tmp/out" vertical-gradient | awk '{ exit !($2 == 1) }' ||
+  fail "vertical-gradient against a vertical ramp should score delta 1: $(cat "$tmp/out")"
+[ "$failures" -ne "$before" ] || echo "ok: size mismatch -> $(grep note "$tmp/err")"
+
+# Errors.
+mkdir -p "$tmp/nan/images" "$tmp/nan/ref" "$tmp/missing"
+cp "$photo" "$tmp/nan/images/c.jpg"
+/usr/bin/python3 -c "
+import numpy as np, sys
+m = np.ones((40, 64), np.float32); m[3, 5] = np.nan; np.save(sys.argv[1], m)" "$tmp/nan/ref/c.npy"
+expect_error "NaN reference" "$tmp/nan/ref/c.npy: contains NaN" depth --images "$tmp/nan/images" --reference "$tmp/nan/ref"
+cp "$photo" "$tmp/images/sub/d.jpg"
+expect_error "missing reference" "$tmp/images/sub/d.jpg: no reference depth map" \
+  depth --images "$tmp/images" --reference "$tmp/ref"
+rm "$tmp/images/sub/d.jpg"
+expect_error "no reference folder" "$tmp/nope: not a directory" depth --images "$tmp/images" --reference "$tmp/nope"
+expect_error "no photos" "no .jpg, .jpeg or .png photos" depth --images "$tmp/missing" --reference "$tmp/ref"
+expect_error "bad model" "--model: 'huge'" depth --images "$tmp/images" --reference "$tmp/ref" --model huge
+expect_error "bad counts" "--counts: 'x'" slicing --images "$tmp/images" --counts 4,x
+expect_error "count out of range" "--counts: '300'" slicing --images "$tmp/images" --counts 300
+
+# Table 3 on one small photo: two rows per count, and the verdict line.
+if "$ampi" eval slicing --images "$tmp/images" --counts 2,4 --reference-planes 16 --poses 2 --max-size 128 \
+    --threads 2 >"$tmp/out" 2>"$tmp/err"; then
+  rows=$(awk '($2 == "uniform" || $2 == "adaptive") && $1 ~ /^[0-9]+$/ && $4 > 0 && $4 <= 1 && $5 > 0' "$tmp/out" | wc -l)
+  [ "$rows" -eq 4 ] || fail "eval slicing: $rows valid rows, expected 4: $(cat "$tmp/out")"
+  grep -q "^adaptive >= uniform at every count: \(yes\|no\)$" "$tmp/out" || fail "eval slicing: no verdict: $(cat "$tmp/out")"
+  [ "$rows" -eq 4 ] && echo "ok: eval slicing -> $(tr '\n' ' ' <"$tmp/out")"
+else
+  fail "eval slicing: exit status $?: $(cat "$tmp/err")"
+fi
+
+[ "$failures" -eq 0 ] || { echo "$failures failure(s)" >&2; exit 1; }
+echo "all eval CLI checks passed"
