@@ -7,13 +7,16 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "inpaint/push_pull.h"
 #include "kernels/ops.h"
 
 namespace ampi {
 namespace {
 
 const char* const kModelName = "ampi-inpaint";
-constexpr int64_t kVersion = 1;
+constexpr int64_t kPlainVersion = 1;     // hole zeroed, output = tanh(last)
+constexpr int64_t kResidualVersion = 2;  // hole pre-filled by push-pull, output = rgb + hole * tanh(last)
+const char* const kPrefill = "push-pull";
 
 [[noreturn]] void fail(const WeightFile& f, const std::string& problem) {
   throw std::runtime_error(f.path() + ": " + problem);
@@ -124,9 +127,13 @@ InpaintNet InpaintNet::load(const std::string& path, const KernelTable& k) {
 InpaintNet InpaintNet::from_file(const WeightFile& f, const KernelTable& k) {
   if (!f.has("model") || f.get_string("model") != kModelName)
     fail(f, std::string("not an inpainting network (metadata 'model' is not '") + kModelName + "')");
-  if (f.get_int("inpaint.version") != kVersion)
-    fail(f, "inpaint.version " + std::to_string(f.get_int("inpaint.version")) + " is not supported");
+  const int64_t version = f.get_int("inpaint.version");
+  if (version != kPlainVersion && version != kResidualVersion)
+    fail(f, "inpaint.version " + std::to_string(version) + " is not supported");
+  if (version == kResidualVersion && f.get_string("inpaint.prefill") != kPrefill)
+    fail(f, "inpaint.prefill '" + f.get_string("inpaint.prefill") + "' is not '" + kPrefill + "'");
   InpaintNet net;
+  net.residual_ = version == kResidualVersion;
   net.k_ = &k;
   net.multiple_ = int(f.get_int("inpaint.multiple"));
   if (net.multiple_ < 1 || net.multiple_ > 64 || (net.multiple_ & (net.multiple_ - 1)))
@@ -165,7 +172,7 @@ void InpaintNet::run(const float* rgb, const float* hole, int h, int w, float* o
   const int64_t pixels = int64_t(h) * w;
   std::vector<float> x(pixels * kInChannels);
   for (int64_t p = 0; p < pixels; ++p) {
-    const float keep = 1.0f - hole[p];
+    const float keep = residual_ ? 1.0f : 1.0f - hole[p];
     for (int c = 0; c < 3; ++c) x[p * kInChannels + c] = rgb[p * 3 + c] * keep;
     x[p * kInChannels + 3] = hole[p];
   }
@@ -193,6 +200,9 @@ void InpaintNet::run(const float* rgb, const float* hole, int h, int w, float* o
     for (int ref : {l.source, l.skip})
       if (ref >= 0 && last_use_[ref] == int(i)) std::vector<float>().swap(outs[ref]);
   }
+  if (residual_)  // the tanh output is a correction of the pre-filled hole
+    for (int64_t p = 0; p < pixels; ++p)
+      for (int c = 0; c < 3; ++c) out[p * 3 + c] = rgb[p * 3 + c] + hole[p] * out[p * 3 + c];
 }
 
 // Layer i's convolution input: its source, up-sampled when asked, then its skip beside
@@ -295,6 +305,8 @@ cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat
   std::vector<cv::Point> points;
   cv::findNonZero(fill, points);
   if (points.empty()) return result;
+  // the network's input colour: push-pull in every unknown pixel for a version-2 net
+  const cv::Mat source = net.prefills_push_pull() ? push_pull_fill(image, known, known == 0) : image;
   const cv::Rect box = cv::boundingRect(points);
   for (int y = box.y; y < box.br().y; y += tiling.core)
     for (int x = box.x; x < box.br().x; x += tiling.core) {
@@ -304,7 +316,7 @@ cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat
       if (in_cell.empty()) continue;
       // run on the fill's own box within the cell: sparse cells cost a small window
       const cv::Rect core = cv::boundingRect(in_cell) + cell.tl();
-      fill_core(net, image, known, fill, core, tiling.halo, result, pool);
+      fill_core(net, source, known, fill, core, tiling.halo, result, pool);
     }
   return result;
 }

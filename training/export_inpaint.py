@@ -2,7 +2,9 @@
 parity fixtures the C++ tests compare against.
 
 File contents (read by inpaint/inpaint_net.cpp):
-  metadata  model = "ampi-inpaint", inpaint.version = 1, the graph of
+  metadata  model = "ampi-inpaint", inpaint.version (1: hole zeroed, output the fill;
+            2: hole pre-filled by push-pull, named in inpaint.prefill, output a residual
+            on it inside the hole; training/inpaint_model.py), the graph of
             training/inpaint_model.py as parallel int arrays (inpaint.source, .upsample,
             .skip, .in_channels, .out_channels, .kernel, .stride, .dilation, .gated),
             inpaint.layer_names (comma-separated), inpaint.feature_activation,
@@ -16,7 +18,9 @@ Fixtures (tests/fixtures/inpaint/):
   bad_*.ampw, no_tensors.ampw  metadata-only files the loader must reject;
   tiny.ampw + tiny_case.ampw   the same graph with fewer channels and seeded random
                                weights, and one input/output pair from PyTorch;
-  bundled_case.ampw            an input/output pair for the exported weights themselves.
+  bundled_case.ampw            an input/output pair for the exported weights themselves;
+  push_pull_*.ampw             images, masks and training/inpaint_push_pull.py's fill,
+                               for the C++ push-pull to match.
 A case file holds rgb [h][w][3] in [-1, 1], hole [h][w] in {0, 1} and expected [h][w][3].
 
     /usr/bin/python3 training/export_inpaint.py --checkpoint training/runs/inpaint/best.pt
@@ -35,6 +39,7 @@ ROOT = os.path.dirname(HERE)
 sys.path.insert(0, HERE)
 sys.path.insert(0, ROOT)
 import inpaint_model as im  # noqa: E402
+import inpaint_push_pull  # noqa: E402
 from weights_format.ampw import write_ampw  # noqa: E402
 
 FIXTURES = os.path.join(ROOT, "tests", "fixtures", "inpaint")
@@ -48,14 +53,16 @@ def narrow_layers(layers, divisor: int):
             for i, row in enumerate(layers)]
 
 
-def graph_metadata(layers):
+def graph_metadata(layers, version: int = 2):
     names = [row[0] for row in layers]
     if any("," in n for n in names):
         raise ValueError("layer names may not contain commas")
     cols = list(zip(*layers))
+    prefill = {"inpaint.prefill": im.PREFILL} if version == 2 else {}
     return {
         "model": "ampi-inpaint",
-        "inpaint.version": 1,
+        "inpaint.version": version,
+        **prefill,
         "inpaint.layer_names": ",".join(names),
         "inpaint.source": list(cols[1]),
         "inpaint.upsample": list(cols[2]),
@@ -69,7 +76,9 @@ def graph_metadata(layers):
         "inpaint.feature_activation": im.FEATURE_ACTIVATION,
         "inpaint.output_activation": im.OUTPUT_ACTIVATION,
         "inpaint.multiple": im.MULTIPLE,
-        "inpaint.input": "rgb/127.5-1 with the hole zeroed, then the hole mask (1 = unknown)",
+        "inpaint.input": ("rgb/127.5-1 with push-pull in the hole, then the hole mask (1 = unknown)"
+                          if version == 2 else
+                          "rgb/127.5-1 with the hole zeroed, then the hole mask (1 = unknown)"),
     }
 
 
@@ -84,7 +93,7 @@ def generator_tensors(g: im.InpaintGenerator):
 
 
 def export(g: im.InpaintGenerator, path: str, extra_metadata=None):
-    meta = graph_metadata(g.layers_spec)
+    meta = graph_metadata(g.layers_spec, g.version)
     meta.update(extra_metadata or {})
     write_ampw(path, generator_tensors(g), meta)
 
@@ -114,10 +123,19 @@ def write_tiny_fixture():
     g = im.InpaintGenerator(narrow_layers(im.LAYERS, 4))
     # random init is small; larger weights make every layer matter in the comparison
     with torch.no_grad():
+        torch.nn.init.normal_(g.convs[-1].weight, std=0.1)  # not the zero start: test it all
+        torch.nn.init.normal_(g.convs[-1].bias, std=0.1)
         for p in g.parameters():
             p.mul_(2.0)
     export(g, os.path.join(FIXTURES, "tiny.ampw"), {"training.source": "seeded random weights (fixture)"})
     write_case(g, os.path.join(FIXTURES, "tiny_case.ampw"), seed=11)
+
+
+def write_push_pull_fixtures():
+    """Odd, even and tiny sizes: INTER_AREA's fractional cells and the 1-pixel levels."""
+    for name, seed, h, w in (("push_pull_odd", 21, 37, 53), ("push_pull_even", 22, 64, 48),
+                             ("push_pull_thin", 23, 5, 19)):
+        inpaint_push_pull.write_fixture(os.path.join(FIXTURES, name + ".ampw"), seed, h, w)
 
 
 def write_bad_fixtures():
@@ -127,6 +145,8 @@ def write_bad_fixtures():
     write_ampw(os.path.join(FIXTURES, "bad_channels.ampw"), {}, bad_channels)
     bad_source = dict(meta, **{"inpaint.source": [-1, 3] + meta["inpaint.source"][2:]})
     write_ampw(os.path.join(FIXTURES, "bad_source.ampw"), {}, bad_source)
+    bad_prefill = dict(meta, **{"inpaint.prefill": "telea"})
+    write_ampw(os.path.join(FIXTURES, "bad_prefill.ampw"), {}, bad_prefill)
     write_ampw(os.path.join(FIXTURES, "no_tensors.ampw"), {}, meta)
 
 
@@ -140,10 +160,11 @@ def main(argv=None):
     os.makedirs(FIXTURES, exist_ok=True)
     write_tiny_fixture()
     write_bad_fixtures()
+    write_push_pull_fixtures()
     if args.tiny_only:
         return 0
     ck = torch.load(args.checkpoint, map_location="cpu")
-    g = im.InpaintGenerator()
+    g = im.InpaintGenerator(residual=ck.get("residual", False))  # the first runs had none
     g.load_state_dict(ck["generator"])
     export(g, args.out, {
         "training.steps": int(ck["step"]),

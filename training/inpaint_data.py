@@ -38,6 +38,9 @@ import torch
 import torch.nn.functional as F
 from PIL import Image, ImageOps
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from inpaint_push_pull import push_pull_fill  # noqa: E402
+
 PHOTO_EXTENSIONS = (".jpg", ".jpeg", ".png")
 DEFAULT_PHOTOS = os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data", "photos")
 DEFAULT_DISPARITY_DIR = os.path.join(os.path.dirname(__file__), "data_cache", "inpaint_disparity")
@@ -213,7 +216,9 @@ def contour_pixels(region: np.ndarray) -> np.ndarray:
 
 def make_sample(photo: Photo, rng: np.random.Generator, crop: int, erode_iterations: int):
     """One training example as float tensors (rgb [3, c, c] in [-1, 1], hole [1, c, c],
-    removed [1, c, c]), or None when this draw has nothing to inpaint."""
+    removed [1, c, c], prefilled [3, c, c]: rgb with every hole pixel replaced by the 8-bit
+    push-pull fill from the known ones, what the C++ filler feeds the network), or None
+    when this draw has nothing to inpaint."""
     h, w = photo.labels.shape
     if photo.planes < 2 or h < crop or w < crop:
         return None
@@ -237,11 +242,15 @@ def make_sample(photo: Photo, rng: np.random.Generator, crop: int, erode_iterati
     # a hole with (almost) no known context around it teaches nothing about the margins
     if removed.mean() < MIN_REMOVED or eroded.mean() < MIN_KNOWN:
         return None
-    rgb = torch.from_numpy(photo.rgb[y0:y0 + crop, x0:x0 + crop]).permute(2, 0, 1).float() / 127.5 - 1.0
+    image = photo.rgb[y0:y0 + crop, x0:x0 + crop]
     hole = 1.0 - eroded
     if rng.random() < 0.5:
-        rgb, hole, removed = rgb.flip(-1), hole.flip(-1), removed.flip(-1)
-    return rgb, hole[None], removed[None]
+        image, hole, removed = image[:, ::-1], hole.flip(-1), removed.flip(-1)
+    image = np.ascontiguousarray(image)
+    known = hole.numpy() < 0.5
+    prefilled = push_pull_fill(image, known, ~known)
+    as_tensor = lambda a: torch.from_numpy(a).permute(2, 0, 1).float() / 127.5 - 1.0  # noqa: E731
+    return as_tensor(image), hole[None], removed[None], as_tensor(prefilled)
 
 
 class SampleSource:
@@ -263,17 +272,26 @@ class SampleSource:
                 return s
 
     def batch(self, rng: np.random.Generator, size: int):
-        rgb, hole, removed = zip(*(self.sample(rng) for _ in range(size)))
-        return torch.stack(rgb), torch.stack(hole), torch.stack(removed)
+        """(rgb, hole, removed, prefilled), each stacked on a new first axis."""
+        return tuple(torch.stack(t) for t in zip(*(self.sample(rng) for _ in range(size))))
 
 
-def prepare_photos(root: str, rels, disparity_dir: str, log=print):
+def prepare_photos(root: str, rels, disparity_dir: str, log=print, standin_too: bool = False):
+    """One Photo per path, sliced with its cached disparity (the stand-in without one);
+    standin_too adds a second Photo sliced with the stand-in where a cached map exists,
+    so the network sees both kinds of plane contours."""
     photos, standins = [], 0
     for rel in rels:
         photos.append(prepare_photo(root, rel, disparity_dir))
-        standins += not os.path.exists(disparity_path(disparity_dir, rel))
-    log(f"prepared {len(photos)} photos ({standins} with the stand-in disparity), "
-        f"{sum(p.planes for p in photos) / len(photos):.1f} planes on average")
+        cached = os.path.exists(disparity_path(disparity_dir, rel))
+        standins += not cached
+        if standin_too and cached:
+            rgb = photos[-1].rgb
+            labels = slice_labels(standin_disparity(rgb, standin_seed(rel)))
+            photos.append(Photo(rel + "#standin", rgb, labels, int(labels.max()) + 1))
+            standins += 1
+    log(f"prepared {len(photos)} sliced photos from {len(rels)} ({standins} with the stand-in "
+        f"disparity), {sum(p.planes for p in photos) / len(photos):.1f} planes on average")
     return photos
 
 

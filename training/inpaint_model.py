@@ -11,8 +11,16 @@ field to about 150 px (the MPI margins are about 40 px wide), nearest up-samplin
 it back, with one skip at 1/2 resolution and the input itself fed to the last stage so
 the known border stays sharp.
 
-    input  = [rgb * (1 - hole), hole]      rgb scaled to [-1, 1], hole in {0, 1}
-    output = tanh(...) in [-1, 1]          the caller keeps known pixels, uses the rest
+Version 2 (the default, PREFILL = "push-pull"): the network refines a classic fill
+instead of starting from nothing. The caller fills every hole pixel with push-pull
+(training/inpaint_push_pull.py, the same algorithm as inpaint/push_pull.cpp) first;
+
+    input  = [rgb, hole]                    rgb in [-1, 1], push-pull in the hole
+    output = rgb + hole * tanh(...)         a learned residual, only inside the hole
+
+and the last layer starts at zero, so an untrained network returns push-pull exactly and
+training starts from push-pull's quality. Version 1 (residual=False, the first bundled
+weights): input [rgb * (1 - hole), hole], output tanh(...).
 
 "hole" is every pixel the network may not look at: at inference everything of the layer
 that is not opaque (the margin to fill and the transparent rest), in training everything
@@ -34,6 +42,7 @@ NO_SKIP = -2  # a layer's skip: none
 FEATURE_ACTIVATION = "elu"  # of the gated layers' feature half (alpha 1)
 OUTPUT_ACTIVATION = "tanh"
 MULTIPLE = 4  # input height and width must be multiples of this (two stride-2 layers)
+PREFILL = "push-pull"  # what fills the hole before a version-2 (residual) network sees it
 
 # One row per layer: (name, source, upsample, skip, out_channels, kernel, stride, dilation,
 # gated). The layer reads layer `source`'s output (INPUT: the network input), up-sampled
@@ -105,10 +114,11 @@ class GatedConv(nn.Module):
 
 
 class InpaintGenerator(nn.Module):
-    def __init__(self, layers=LAYERS):
+    def __init__(self, layers=LAYERS, residual: bool = True):
         super().__init__()
         check_layers(layers)
         self.layers_spec = layers
+        self.residual = residual
         self.convs = nn.ModuleList()
         for (name, _src, _up, _skip, out_c, kernel, stride, dil, gated), in_c in zip(
                 layers, layer_in_channels(layers)):
@@ -116,13 +126,21 @@ class InpaintGenerator(nn.Module):
                 self.convs.append(GatedConv(in_c, out_c, kernel, stride, dil))
             else:
                 self.convs.append(nn.Conv2d(in_c, out_c, kernel, stride, dil * (kernel - 1) // 2, dil))
+        if residual:  # start as the identity on the pre-filled input: push-pull's quality
+            nn.init.zeros_(self.convs[-1].weight)
+            nn.init.zeros_(self.convs[-1].bias)
+
+    @property
+    def version(self) -> int:
+        return 2 if self.residual else 1
 
     def forward(self, rgb: torch.Tensor, hole: torch.Tensor) -> torch.Tensor:
-        """rgb: [N, 3, H, W] in [-1, 1]; hole: [N, 1, H, W] in {0, 1}. Returns the
-        prediction for every pixel, [N, 3, H, W] in [-1, 1]."""
+        """rgb: [N, 3, H, W] in [-1, 1] (residual: push-pull already in the hole);
+        hole: [N, 1, H, W] in {0, 1}. Returns the prediction for every pixel, [N, 3, H, W]
+        (the known pixels unchanged when residual)."""
         if rgb.shape[-2] % MULTIPLE or rgb.shape[-1] % MULTIPLE:
             raise ValueError(f"input size {tuple(rgb.shape[-2:])} is not a multiple of {MULTIPLE}")
-        x = torch.cat([rgb * (1.0 - hole), hole], dim=1)
+        x = torch.cat([rgb if self.residual else rgb * (1.0 - hole), hole], dim=1)
         outs = []
         for (name, source, up, skip, *_rest), conv in zip(self.layers_spec, self.convs):
             y = x if source == INPUT else outs[source]
@@ -131,6 +149,8 @@ class InpaintGenerator(nn.Module):
             if skip != NO_SKIP:
                 y = torch.cat([y, x if skip == INPUT else outs[skip]], dim=1)
             outs.append(conv(y))
+        if self.residual:
+            return rgb + hole * torch.tanh(outs[-1])
         return torch.tanh(outs[-1])
 
 

@@ -96,8 +96,8 @@ def pixel_losses(pred, target, removed):
     return data_term, grad_term
 
 
-def generator_step(g, d, phi, opt_g, rgb, hole, removed):
-    pred = g(rgb, hole)
+def generator_step(g, d, phi, opt_g, rgb, hole, removed, prefilled):
+    pred = g(prefilled, hole)
     fake = rgb * (1 - removed) + pred * removed
     l_data, l_grad = pixel_losses(pred, rgb, removed)
     l_disc = -d(fake, removed).mean()
@@ -130,8 +130,8 @@ def validate(g, val_batches):
     """Mean L1 and PSNR over the removed pixels of the fixed validation samples."""
     g.eval()
     l1, se, count = 0.0, 0.0, 0.0
-    for rgb, hole, removed in val_batches:
-        diff = (g(rgb, hole) - rgb) * removed
+    for rgb, hole, removed, prefilled in val_batches:
+        diff = (g(prefilled, hole) - rgb) * removed
         l1 += float(diff.abs().sum())
         se += float((diff ** 2).sum())
         count += float(removed.sum()) * 3
@@ -152,7 +152,8 @@ def save_atomic(obj, path):
 
 def validation_key(args):
     """What the fixed validation samples depend on besides the photos."""
-    return {"crop": args.crop, "batch": args.batch, "seed": VALIDATION_SEED}
+    return {"crop": args.crop, "batch": args.batch, "seed": VALIDATION_SEED,
+            "standin_too": args.standin_too}
 
 
 def load_or_init(args, g, d, opt_g, opt_d, log):
@@ -179,7 +180,7 @@ def load_or_init(args, g, d, opt_g, opt_d, log):
 
 
 def checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi):
-    save_atomic({"step": step, "best_psnr": best, "generator": g.state_dict(),
+    save_atomic({"step": step, "best_psnr": best, "generator": g.state_dict(), "residual": g.residual,
                  "discriminator": d.state_dict(), "opt_g": opt_g.state_dict(),
                  "opt_d": opt_d.state_dict(), "torch_rng": torch.get_rng_state(),
                  "numpy_rng": rng.bit_generator.state, "perceptual": phi.source,
@@ -204,6 +205,10 @@ def parse_args(argv):
     ap.add_argument("--validate-every", type=int, default=250)
     ap.add_argument("--checkpoint-every", type=int, default=100)
     ap.add_argument("--max-photos", type=int, default=0, help="use only the first N (smoke tests)")
+    ap.add_argument("--standin-too", action="store_true",
+                    help="slice photos with a cached disparity map a second time with the stand-in")
+    ap.add_argument("--plain", action="store_true",
+                    help="version-1 generator: hole zeroed, no push-pull pre-fill, no residual")
     return ap.parse_args(argv)
 
 
@@ -218,18 +223,23 @@ def main(argv=None):
     train_rel, val_rel = data.split_photos(data.list_photos(args.photos))
     if args.max_photos:
         train_rel, val_rel = train_rel[:args.max_photos], val_rel[:max(1, args.max_photos // 10)]
-    train = data.SampleSource(data.prepare_photos(args.photos, train_rel, args.disparity_dir, log), args.crop)
-    val_batches = fixed_validation(
-        data.SampleSource(data.prepare_photos(args.photos, val_rel, args.disparity_dir, log), args.crop),
-        args.batch)
+    prepare = lambda rels: data.prepare_photos(  # noqa: E731
+        args.photos, rels, args.disparity_dir, log, standin_too=args.standin_too)
+    train = data.SampleSource(prepare(train_rel), args.crop)
+    val_batches = fixed_validation(data.SampleSource(prepare(val_rel), args.crop), args.batch)
 
     torch.manual_seed(args.seed)
-    g, d = InpaintGenerator(), PatchDiscriminator()
+    g, d = InpaintGenerator(residual=not args.plain), PatchDiscriminator()
     phi = PerceptualFeatures(args.perceptual)
     log(f"perceptual features: depth encoder, {phi.source}")
     opt_g = torch.optim.Adam(g.parameters(), lr=args.lr_g, betas=BETAS)
     opt_d = torch.optim.Adam(d.parameters(), lr=args.lr_d, betas=BETAS)
     step, best, rng = load_or_init(args, g, d, opt_g, opt_d, log)
+    if step == 0:  # what training starts from (push-pull itself for the residual net)
+        best = validate(g, val_batches)[1]
+        save_atomic({"step": 0, "val_psnr": best, "generator": g.state_dict(), "residual": g.residual},
+                    os.path.join(args.run_dir, "best.pt"))
+        log(f"step 0: validation PSNR {best:.4f} (best.pt keeps it until a step beats it)")
 
     log_path = os.path.join(args.run_dir, "log.csv")
     fields = ["step", "time", "loss_g", "data", "grad", "disc", "perc", "loss_d", "val_l1", "val_psnr"]
@@ -240,8 +250,8 @@ def main(argv=None):
             writer.writeheader()
         running, started = {}, time.time()
         while step < args.steps:
-            rgb, hole, removed = train.batch(rng, args.batch)
-            fake, parts = generator_step(g, d, phi, opt_g, rgb, hole, removed)
+            rgb, hole, removed, prefilled = train.batch(rng, args.batch)
+            fake, parts = generator_step(g, d, phi, opt_g, rgb, hole, removed, prefilled)
             parts["loss_d"] = discriminator_step(d, opt_d, rgb, fake, removed)
             step += 1
             for k, v in parts.items():
@@ -255,7 +265,8 @@ def main(argv=None):
                 row["val_l1"], row["val_psnr"] = validate(g, val_batches)
                 if row["val_psnr"] > best:
                     best = row["val_psnr"]
-                    save_atomic({"step": step, "val_psnr": best, "generator": g.state_dict()},
+                    save_atomic({"step": step, "val_psnr": best, "generator": g.state_dict(),
+                                 "residual": g.residual},
                                 os.path.join(args.run_dir, "best.pt"))
             if row is not None:
                 row.update(step=step, time=round(time.time() - started, 1))

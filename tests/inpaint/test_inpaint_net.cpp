@@ -10,6 +10,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "inpaint/inpaint_net.h"
+#include "inpaint/push_pull.h"
 #include "support/random.h"
 
 using namespace ampi;
@@ -115,6 +116,28 @@ TEST_CASE("inpaint net: the graph is read from the file", "[inpaint]") {
   CHECK(net.layers().back().scale_log2 == 0);
   CHECK_FALSE(net.layers().back().gated);
   CHECK(net.macs_per_pixel() > 0);
+  CHECK(net.prefills_push_pull());  // version 2
+}
+
+TEST_CASE("inpaint net: version 2 changes only the hole of its input", "[inpaint]") {
+  const Case c = load_case(kFixtures + "tiny_case.ampw");
+  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const size_t pixels = size_t(c.h) * c.w;
+  std::vector<float> out(pixels * 3);
+  net.run(c.rgb.f32(), c.hole.f32(), c.h, c.w, out.data());
+  int known = 0, kept = 0, hole_changed = 0;
+  for (size_t p = 0; p < pixels; ++p)
+    for (int ch = 0; ch < 3; ++ch) {
+      const bool same = out[p * 3 + ch] == c.rgb.f32()[p * 3 + ch];
+      if (c.hole.f32()[p] == 0.0f) {
+        ++known;
+        kept += same;
+      } else {
+        hole_changed += !same;
+      }
+    }
+  CHECK(kept == known);
+  CHECK(hole_changed > 0);
 }
 
 TEST_CASE("inpaint net: results do not depend on the thread count", "[inpaint]") {
@@ -141,6 +164,8 @@ TEST_CASE("inpaint net: bad inputs and bad files are one-line errors", "[inpaint
   CHECK(missing.rfind(kFixtures + "no_tensors.ampw: ", 0) == 0);
   CHECK(missing.find("enc1.weight") != std::string::npos);
   CHECK(missing.find('\n') == std::string::npos);
+  const std::string prefill = expect_load_error("bad_prefill.ampw");
+  CHECK(prefill == kFixtures + "bad_prefill.ampw: inpaint.prefill 'telea' is not 'push-pull'");
   const std::string depth = expect_load_error("tiny_case.ampw");
   CHECK(depth.find("not an inpainting network") != std::string::npos);
 }
@@ -164,11 +189,14 @@ TEST_CASE("inpaint filler: one window over the whole layer equals a direct run",
   const Layer l = random_layer(h, w, 3);
   const cv::Mat out = inpaint_layer(net, l.image, l.known, l.fill, {256, 256});
 
+  // a version-2 network reads push-pull's fill in every unknown pixel
+  REQUIRE(net.prefills_push_pull());
+  const cv::Mat input = push_pull_fill(l.image, l.known, l.known == 0);
   std::vector<float> rgb(size_t(h) * w * 3), hole(size_t(h) * w), pred(size_t(h) * w * 3);
   for (int y = 0; y < h; ++y)
     for (int x = 0; x < w; ++x) {
       const size_t p = size_t(y) * w + x;
-      const cv::Vec4b px = l.image.at<cv::Vec4b>(y, x);
+      const cv::Vec4b px = input.at<cv::Vec4b>(y, x);
       for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = px[2 - c] / 127.5f - 1.0f;
       hole[p] = l.known.at<uint8_t>(y, x) ? 0.0f : 1.0f;
     }
