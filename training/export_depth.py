@@ -187,7 +187,7 @@ def load_checkpoint(path: str):
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("checkpoint", help="train_depth.py checkpoint.pt")
+    p.add_argument("checkpoint", help="train_depth.py checkpoint.pt or best.pt")
     p.add_argument("output", help="the .ampw file to write")
     p.add_argument("--data", default="", help="what the network was trained on (recorded in the metadata)")
     p.add_argument("--working-long-side", type=int, default=1024,
@@ -196,7 +196,7 @@ def main(argv=None):
     args = p.parse_args(argv)
     model, ckpt = load_checkpoint(args.checkpoint)
     meta = export(model, args.output, {"steps": int(ckpt["step"]), "data": args.data,
-                                       "best_val_loss": float(ckpt["best_val"])},
+                                       "best_val_loss": float(ckpt.get("best_val", ckpt.get("val_loss")))},
                   args.working_long_side)
     size = Path(args.output).stat().st_size
     print(f"{args.output}: {meta['depth.variant']}, {meta['depth.parameters']} parameters, "
