@@ -19,6 +19,7 @@ const Benchmark kBenchmarks[] = {
     {"kernels", bench::kernels_benchmark, "convolution kernels vs the machine's FMA peak and memory bandwidth"},
     {"render", bench::render_benchmark, "MPI renderer frames/s vs the naive compositor (1024x768, 8 planes)"},
     {"pipeline", bench::pipeline_benchmark, "ampi run stage by stage, peak memory (1024x768 and 4K)"},
+    {"network", bench::network_benchmark, "the depth network alone on an .npy image (bench/peers/run.sh: vs its peers)"},
 };
 
 void usage(FILE* out) {

@@ -25,3 +25,16 @@ if [ ${#missing[@]} -gt 0 ]; then
   $SUDO apt-get update -q
   $SUDO apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
+
+# The peer benchmark's ONNX Runtime (bench/peers/run.sh): npm's onnxruntime-node at the
+# locked version, its bundled CPU library only (ONNXRUNTIME_NODE_INSTALL=skip: no CUDA
+# download). Re-installed only when the lock file is newer than the installed tree.
+peers="$(cd "$(dirname "$0")/.." && pwd)/bench/peers"
+if [ "$peers/package-lock.json" -nt "$peers/node_modules/.package-lock.json" ]; then
+  if ! command -v npm >/dev/null; then
+    SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
+    $SUDO apt-get update -q
+    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends nodejs npm
+  fi
+  (cd "$peers" && ONNXRUNTIME_NODE_INSTALL=skip npm ci --no-audit --no-fund)
+fi

@@ -1,0 +1,316 @@
+"""The peer benchmark: ampi's depth network beside ONNX Runtime, OpenCV DNN and PyTorch
+running the same network on the same pixels with the same thread counts. Called by
+bench/peers/run.sh (which installs and builds what it needs); writes bench/RESULTS.md.
+
+For every network and size: the bundled example photo resized to the size is the input
+of all four engines; each engine process loads the network once and, per thread count,
+runs it --warmup times untimed and then N times timed (medians reported); each saves its
+output, and every peer's output is compared with ampi's (largest absolute difference
+relative to the range of ampi's output: the proof that they ran the same network).
+
+--smoke runs a tiny case (64x64) and only checks the differences against --tolerance:
+the ctest test peers_smoke. Any engine that is missing or fails stops the run with its
+error (exit 1): a peer is never skipped.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+HERE = Path(__file__).resolve().parent
+REPO = HERE.parents[1]
+sys.path.insert(0, str(REPO / "weights_format"))
+from ampw import read_ampw  # noqa: E402
+
+PEERS = ("onnxruntime", "opencv-dnn", "pytorch")
+PEER_TITLES = {"onnxruntime": "ONNX Runtime", "opencv-dnn": "OpenCV DNN", "pytorch": "PyTorch"}
+# The issue's targets: ampi's latency at most this fraction of the peer's (lite, 1024x768, 2 threads).
+TARGETS = {"onnxruntime": 0.8, "opencv-dnn": 0.5, "pytorch": 0.3}
+TARGET_CASE = ("lite", (1024, 768), 2)
+
+
+def parse_size(text: str):
+    w, h = (int(v) for v in text.lower().split("x"))
+    return w, h
+
+
+def parse_sizes_runs(text: str):
+    """'512x384:7,1024x768:5' -> [((512, 384), 7), ((1024, 768), 5)]."""
+    out = []
+    for item in text.split(","):
+        size, _, runs = item.partition(":")
+        out.append((parse_size(size), int(runs or 5)))
+    return out
+
+
+def fail(message: str):
+    print(f"run_peers.py: {message}", file=sys.stderr)
+    sys.exit(1)
+
+
+# ---- inputs and exports -------------------------------------------------------------------
+
+def make_inputs(photo: Path, size, multiple: int, folder: Path):
+    """The photo resized to `size` as RGB floats in [0, 1]: H x W x 3 for ampi (which pads
+    to its multiple itself) and 1 x 3 x Hp x Wp for the peers, padded the way ampi pads
+    (bottom rows and right columns replicate the last ones)."""
+    w, h = size
+    rgb = np.asarray(Image.open(photo).convert("RGB").resize((w, h), Image.BILINEAR), np.float32) / 255.0
+    hp, wp = -(-h // multiple) * multiple, -(-w // multiple) * multiple
+    padded = np.pad(rgb, ((0, hp - h), (0, wp - w), (0, 0)), mode="edge")
+    hwc, nchw = folder / f"input_{w}x{h}_hwc.npy", folder / f"input_{w}x{h}_nchw.npy"
+    np.save(hwc, np.ascontiguousarray(rgb))
+    np.save(nchw, np.ascontiguousarray(padded.transpose(2, 0, 1)[None]))
+    return hwc, nchw, (wp, hp)
+
+
+def export_onnx(weights: Path, padded_size, folder: Path) -> Path:
+    """The network's ONNX export for one padded input size (re-made when older than the
+    weights or the export code)."""
+    wp, hp = padded_size
+    onnx = folder / f"{weights.stem}_{wp}x{hp}.onnx"
+    sources = [weights, HERE / "export_onnx.py", HERE / "peer_net.py"]
+    if onnx.exists() and all(onnx.stat().st_mtime >= s.stat().st_mtime for s in sources):
+        return onnx
+    run_checked([sys.executable, str(HERE / "export_onnx.py"), str(weights), str(onnx), "--size", f"{wp}x{hp}"],
+                f"ONNX export of {weights.name} at {wp}x{hp}")
+    return onnx
+
+
+# ---- engines ------------------------------------------------------------------------------
+
+def run_checked(cmd, what: str) -> str:
+    try:
+        proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO)
+    except OSError as e:
+        fail(f"{what}: cannot start {cmd[0]}: {e.strerror}")
+    if proc.returncode != 0:
+        err = (proc.stderr or proc.stdout).strip().splitlines()
+        fail(f"{what} failed (exit {proc.returncode}): {err[-1] if err else 'no message'}\n  command: {' '.join(cmd)}")
+    return proc.stdout
+
+
+def engine_commands(args, weights: Path, onnx: Path, hwc: Path, nchw: Path, runs: int, save: Path):
+    common = ["--threads", ",".join(map(str, args.threads)), "--runs", str(runs), "--warmup", str(args.warmup)]
+    return {
+        "ampi": [args.ampi, "bench", "network", "--weights", str(weights), "--input", str(hwc),
+                 "--save", f"{save}_ampi"] + common,
+        "onnxruntime": ["node", str(HERE / "ort_peer.js"), "--model", str(onnx), "--input", str(nchw),
+                        "--save", f"{save}_onnxruntime"] + common,
+        "opencv-dnn": [args.opencv_peer, "--model", str(onnx), "--input", str(nchw),
+                       "--save", f"{save}_opencv-dnn"] + common,
+        "pytorch": [sys.executable, str(HERE / "torch_peer.py"), "--weights", str(weights), "--input", str(nchw),
+                    "--save", f"{save}_pytorch"] + common,
+    }
+
+
+def run_engine(name: str, cmd) -> dict:
+    """{threads: {"ms": [...], ...}} from the engine's JSON lines."""
+    results = {}
+    for line in run_checked(cmd, name).splitlines():
+        if line.startswith("{"):
+            record = json.loads(line)
+            results[int(record["threads"])] = record
+    return results
+
+
+def relative_difference(peer: np.ndarray, ampi: np.ndarray) -> float:
+    h, w = ampi.shape
+    if peer.shape[0] < h or peer.shape[1] < w:
+        fail(f"a peer's output {peer.shape} is smaller than ampi's {ampi.shape}")
+    span = float(ampi.max() - ampi.min())
+    if not span > 0:
+        fail("ampi's output is constant: the differences would prove nothing")
+    return float(np.abs(peer[:h, :w].astype(np.float64) - ampi).max() / span)
+
+
+def measure_case(args, weights: Path, size, runs: int, folder: Path, multiple: int) -> dict:
+    hwc, nchw, padded = make_inputs(args.photo, size, multiple, folder)
+    onnx = export_onnx(weights, padded, folder)
+    save = folder / f"out_{weights.stem}_{size[0]}x{size[1]}"
+    case = {"model": weights.stem.replace("depth_", ""), "size": size, "padded": padded, "runs": runs,
+            "engines": {}, "diff": {}, "range": {}}
+    for name, cmd in engine_commands(args, weights, onnx, hwc, nchw, runs, save).items():
+        print(f"  {case['model']} {size[0]}x{size[1]}: {name} ...", file=sys.stderr, flush=True)
+        case["engines"][name] = run_engine(name, cmd)
+    for t in args.threads:
+        ampi = np.load(f"{save}_ampi.t{t}.npy").astype(np.float64)
+        case["range"][t] = (float(ampi.min()), float(ampi.max()))
+        for peer in PEERS:
+            case["diff"].setdefault(peer, {})[t] = relative_difference(np.load(f"{save}_{peer}.t{t}.npy"), ampi)
+    return case
+
+
+def median_ms(case, engine, threads) -> float:
+    return statistics.median(case["engines"][engine][threads]["ms"])
+
+
+# ---- the table ----------------------------------------------------------------------------
+
+def cpu_model() -> str:
+    for line in Path("/proc/cpuinfo").read_text().splitlines():
+        if line.startswith("model name"):
+            return line.split(":", 1)[1].strip()
+    return platform.processor() or "unknown"
+
+
+def git_commit() -> str:
+    proc = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=REPO)
+    return proc.stdout.strip() or "unknown"
+
+
+def versions(cases) -> dict:
+    first = cases[0]["engines"]
+    t = next(iter(first["ampi"]))
+    return {"isa": first["ampi"][t].get("isa", "?"), "ort": first["onnxruntime"][t].get("version", "?"),
+            "torch": first["pytorch"][t].get("version", "?"),
+            "torch_format": first["pytorch"][t].get("memory_format", "?")}
+
+
+def opencv_version(opencv_peer: str) -> str:
+    proc = subprocess.run([opencv_peer, "--version"], capture_output=True, text=True)
+    return proc.stdout.strip() or "?"
+
+
+def targets_section(cases) -> list:
+    model, size, threads = TARGET_CASE
+    case = next((c for c in cases if c["model"] == model and tuple(c["size"]) == size), None)
+    lines = [f"## Targets: ampi {model} at {size[0]}x{size[1]}, {threads} threads", ""]
+    if case is None or threads not in case["engines"]["ampi"]:
+        return lines + ["Not measured in this run (the target case was not among the sizes and threads).", ""]
+    ampi = median_ms(case, "ampi", threads)
+    lines += ["| peer | target (ampi / peer) | ampi (ms) | peer (ms) | measured ratio | |", "|---|---:|---:|---:|---:|---|"]
+    for peer in PEERS:
+        ms = median_ms(case, peer, threads)
+        ratio = ampi / ms
+        verdict = "**met**" if ratio <= TARGETS[peer] else "**not met**"
+        lines.append(f"| {PEER_TITLES[peer]} | <= {TARGETS[peer]:.1f}x | {ampi:.1f} | {ms:.1f} | {ratio:.2f}x | {verdict} |")
+    return lines + [""]
+
+
+def latency_section(cases, threads_list) -> list:
+    lines = ["## Latency (median ms) and ratios ampi / peer", "",
+             "| network | size | threads | runs | ampi | ONNX Runtime | OpenCV DNN | PyTorch | "
+             "ampi / ORT | ampi / OpenCV | ampi / PyTorch |",
+             "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    for case in cases:
+        for t in threads_list:
+            ampi = median_ms(case, "ampi", t)
+            peers = [median_ms(case, p, t) for p in PEERS]
+            w, h = case["size"]
+            lines.append(f"| {case['model']} | {w}x{h} | {t} | {case['runs']} | {ampi:.1f} | "
+                         + " | ".join(f"{ms:.1f}" for ms in peers) + " | "
+                         + " | ".join(f"{ampi / ms:.2f}" for ms in peers) + " |")
+    return lines + [""]
+
+
+def difference_section(cases, threads_list) -> list:
+    lines = ["## Same network: largest output difference against ampi", "",
+             "max |peer - ampi| / (max(ampi) - min(ampi)) over the whole disparity map, the largest",
+             f"over thread counts {', '.join(map(str, threads_list))}.", "",
+             "| network | size | ampi output range | ONNX Runtime | OpenCV DNN | PyTorch |", "|---|---|---|---:|---:|---:|"]
+    for case in cases:
+        w, h = case["size"]
+        lo = min(case["range"][t][0] for t in threads_list)
+        hi = max(case["range"][t][1] for t in threads_list)
+        diffs = [max(case["diff"][p].values()) for p in PEERS]
+        lines.append(f"| {case['model']} | {w}x{h} | {lo:.3f} .. {hi:.3f} | " + " | ".join(f"{d:.1e}" for d in diffs) + " |")
+    return lines + [""]
+
+
+def write_results(args, cases, seconds: float):
+    v = versions(cases)
+    padded = [c for c in cases if tuple(c["padded"]) != tuple(c["size"])]
+    pad_note = ""
+    if padded:
+        c = padded[0]
+        pad_note = (f" Sizes that are not multiples of the network's {args.multiple} (e.g. {c['size'][0]}x{c['size'][1]}) "
+                    f"run at {c['padded'][0]}x{c['padded'][1]}: ampi pads inside its timed run (edge replication), "
+                    "the peers get the image padded the same way before timing (their export has that size), "
+                    "and their outputs are cropped back for the comparison.")
+    lines = [
+        "# Peer benchmark: ampi's depth network beside ONNX Runtime, OpenCV DNN and PyTorch", "",
+        "Made by `bash bench/peers/run.sh` (bench/peers/README.md) in one run of "
+        f"{seconds / 60:.1f} minutes at commit {git_commit()}; rerun it to refresh this file.", "",
+        f"- Machine: {cpu_model()}, {os.cpu_count()} cores; ampi's kernels: {v['isa']}.",
+        "- Engines, all on the CPU, the same thread count each (1, then 2):",
+        "  ampi (`ampi bench network`, DepthNet::run on its own kernels);",
+        f"  ONNX Runtime {v['ort']} (npm's onnxruntime-node, CPU provider, all graph optimisations, "
+        "intra-op threads = T, inter-op 1);",
+        f"  OpenCV {opencv_version(args.opencv_peer)} DNN (Debian's, OpenCV backend, `cv::setNumThreads(T)`);",
+        f"  PyTorch {v['torch']} (Debian's, eager, inference mode, {v['torch_format']} memory format, "
+        "`torch.set_num_threads(T)`).",
+        "- The same network for all: the weight file `weights/depth_*.ampw`; ONNX Runtime and OpenCV run "
+        "its ONNX export with BatchNorm folded (bench/peers/export_onnx.py), PyTorch the same folded "
+        "network rebuilt from the file (bench/peers/peer_net.py).",
+        f"- Input: `{args.photo.relative_to(REPO) if args.photo.is_relative_to(REPO) else args.photo}` resized "
+        "to each size, RGB in [0, 1], the same pixels for every engine; each engine times the network "
+        "call alone (input normalisation included, loading excluded), wall clock, after "
+        f"{args.warmup} untimed run(s); medians of the runs given per row.{pad_note}",
+        "- Ratios below 1 mean ampi is faster.", "",
+    ]
+    lines += targets_section(cases) + latency_section(cases, args.threads) + difference_section(cases, args.threads)
+    text = "\n".join(lines)
+    Path(args.results).write_text(text)
+    print(text)
+    print(f"run_peers.py: wrote {args.results}", file=sys.stderr)
+
+
+# ---- main ---------------------------------------------------------------------------------
+
+def main(argv=None):
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--ampi", required=True, help="the ampi program")
+    p.add_argument("--opencv-peer", required=True, help="the ampi_peer_opencv_dnn program")
+    p.add_argument("--work", type=Path, default=REPO / "out" / "peers", help="inputs, exports, outputs")
+    p.add_argument("--models", default="lite,heavy")
+    p.add_argument("--sizes", default="512x384:9,1024x768:7,1920x1080:5",
+                   help="WxH:RUNS,... (timed runs per thread count)")
+    p.add_argument("--threads", default="1,2")
+    p.add_argument("--warmup", type=int, default=1)
+    p.add_argument("--photo", type=Path, default=REPO / "examples" / "forest_path.jpg")
+    p.add_argument("--results", default=str(REPO / "bench" / "RESULTS.md"))
+    p.add_argument("--smoke", action="store_true", help="64x64 lite, 1 run, check differences only")
+    p.add_argument("--tolerance", type=float, default=1e-3, help="largest relative difference --smoke accepts")
+    args = p.parse_args(argv)
+    if args.smoke:
+        args.models, args.sizes, args.warmup = "lite", "64x64:1", 0
+    args.threads = [int(t) for t in args.threads.split(",")]
+    args.work.mkdir(parents=True, exist_ok=True)
+    if not args.photo.is_file():
+        fail(f"{args.photo}: no such photo")
+
+    start = time.time()
+    cases = []
+    for model in args.models.split(","):
+        weights = REPO / "weights" / f"depth_{model}.ampw"
+        if not weights.is_file():
+            fail(f"{weights}: no such weight file")
+        args.multiple = int(read_ampw(str(weights))[0]["depth.multiple"])
+        for size, runs in parse_sizes_runs(args.sizes):
+            cases.append(measure_case(args, weights, size, runs, args.work, args.multiple))
+
+    if args.smoke:
+        worst = max(max(c["diff"][p].values()) for c in cases for p in PEERS)
+        for c in cases:
+            for peer in PEERS:
+                print(f"{c['model']} {c['size'][0]}x{c['size'][1]} {peer}: largest relative difference "
+                      f"{max(c['diff'][peer].values()):.2e}")
+        if worst > args.tolerance:
+            fail(f"a peer's output differs from ampi's by {worst:.2e} of its range (tolerance {args.tolerance:.0e})")
+        return
+    write_results(args, cases, time.time() - start)
+
+
+if __name__ == "__main__":
+    main()
