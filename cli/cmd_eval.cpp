@@ -268,13 +268,14 @@ int eval_depth(int argc, char** argv) {
 const char kSlicingUsage[] =
     "usage: ampi eval slicing --images DIR [--counts 4,8,16] [--reference-planes N] [--poses N]\n"
     "                         [--amplitude A] [--max-size N] [--model lite|heavy | --weights FILE]\n"
-    "                         [--working-size N] [--inpainter push-pull|network] [--limit N] [--threads N]\n"
+    "                         [--working-size N] [--depth-dir D] [--inpainter push-pull|network]\n"
+    "                         [--limit N] [--threads N]\n"
     "\n"
     "The paper's Table 3 (Luvizon et al., WACV 2021: adaptive against uniform slicing, SSIM and\n"
     "PSNR of novel views) on every photo under DIR (.jpg, .jpeg, .png, recursively, sorted).\n"
     "Photos have no second view, so, as the paper does for its own photos, views are compared\n"
     "with those of a densely sampled MPI. Per photo (scaled down to --max-size) and per\n"
-    "maximum plane count N, three MPIs from the same depth (our network), the same slicing\n"
+    "maximum plane count N, three MPIs from the same depth (our network, or --depth-dir), the same slicing\n"
     "depth range and the same inpainting:\n"
     "  adaptive   the paper's adaptive slicing, at most N planes (it makes n)\n"
     "  uniform    equal disparity intervals, n planes: the count adaptive made for the photo\n"
@@ -288,18 +289,20 @@ const char kSlicingUsage[] =
     "\n"
     "  --images DIR            photos\n"
     "  --counts LIST           maximum plane counts, comma-separated (default 4,8,16)\n"
-    "  --reference-planes N    planes of the dense reference MPI (default 64)\n"
+    "  --reference-planes N    planes of the dense reference MPI (default 255: one per level)\n"
     "  --poses N               target poses (default 8)\n"
     "  --amplitude A           circle radius / nearest reference depth (default 0.05)\n"
     "  --max-size N            photos are scaled down to this long side (default 512)\n"
     "  --model M, --weights F  depth network: bundled lite (default) or heavy, or a file\n"
     "  --working-size N        long side the network runs at (default: the weight file's)\n"
+    "  --depth-dir D           depth maps instead of the network: the one file D/sub/name.* for\n"
+    "                          DIR/sub/name.jpg, any format ampi run --depth reads, larger = nearer\n"
     "  --inpainter I           push-pull (default, as ampi run) or network (weights/inpaint.ampw)\n"
     "  --limit N               only the first N photos\n"
     "  --threads N             worker threads (default: all hardware threads)\n";
 
 struct SlicingEvalArgs {
-  std::string images, model = "lite", weights, inpainter = "push-pull";
+  std::string images, model = "lite", weights, depth_dir, inpainter = "push-pull";
   SlicingEvalOptions options;
   int max_size = 512, working_size = 0, limit = 0, threads = 0;
 };
@@ -362,6 +365,7 @@ int eval_slicing(int argc, char** argv) {
   });
   p.option("--weights", &a.weights);
   p.option("--working-size", &a.working_size, 16, 16384);
+  p.option("--depth-dir", &a.depth_dir);
   p.option("--inpainter", [&](const std::string& v) {
     if (v != "push-pull" && v != "network") throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
     a.inpainter = v;
@@ -374,14 +378,23 @@ int eval_slicing(int argc, char** argv) {
 
   std::vector<std::string> photos = list_images(a.images);
   if (a.limit > 0 && size_t(a.limit) < photos.size()) photos.resize(a.limit);
-  DepthNet net = DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
-  const int side = a.working_size ? a.working_size : net.working_long_side();
+  std::vector<std::string> depth_maps;  // looked up first: a missing one stops at once
+  if (!a.depth_dir.empty()) {
+    if (!fs::is_directory(a.depth_dir)) throw std::runtime_error(a.depth_dir + ": not a directory");
+    for (const std::string& photo : photos) depth_maps.push_back(find_depth_reference(photo, a.images, a.depth_dir));
+  }
+  std::optional<DepthNet> net;
+  if (depth_maps.empty())
+    net.emplace(DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights));
+  const int side = a.working_size ? a.working_size : net ? net->working_long_side() : 0;
   SlicingEvaluator eval(a.options, slicing_filler(a.inpainter));
   std::vector<int> psnr_wins(a.options.counts.size()), ssim_wins(a.options.counts.size());
-  for (const std::string& path : photos) {
+  for (size_t k = 0; k < photos.size(); ++k) {
+    const std::string& path = photos[k];
     const cv::Mat bgr = fit_long_side(read_photo(path), a.max_size);
     cv::Mat disparity;
-    cv::resize(estimate_disparity(net, bgr, side), disparity, bgr.size(), 0, 0, cv::INTER_LINEAR);
+    cv::resize(net ? estimate_disparity(*net, bgr, side) : read_depth_map(depth_maps[k], false), disparity,
+               bgr.size(), 0, 0, cv::INTER_LINEAR);
     const std::vector<SlicingScore> rows = eval.add(bgr, disparity);
     std::string line;
     for (size_t i = 0; i + 1 < rows.size(); i += 2) {
@@ -397,7 +410,8 @@ int eval_slicing(int argc, char** argv) {
   print_slicing_table(eval.mean(), psnr_wins, ssim_wins);
   std::printf("(%zu photos at most %d px, %d poses, amplitude %g, reference of %d planes, %s inpainting, %s depth)\n",
               photos.size(), a.max_size, a.options.poses, a.options.amplitude, a.options.reference_planes,
-              a.inpainter.c_str(), a.weights.empty() ? a.model.c_str() : a.weights.c_str());
+              a.inpainter.c_str(),
+              !a.depth_dir.empty() ? "--depth-dir" : a.weights.empty() ? a.model.c_str() : a.weights.c_str());
   return 0;
 }
 

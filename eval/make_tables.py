@@ -37,10 +37,23 @@ def shown(command):
     return ' '.join(str(Path(c).relative_to(REPO)) if str(c).startswith(str(REPO)) else str(c) for c in command)
 
 
+def write_scenes(folder, count):
+    subprocess.run([sys.executable, str(REPO / 'training' / 'make_eval_scenes.py'), folder, '--count', str(count)],
+                   check=True, capture_output=True)
+
+
+def first_row(out, method):
+    """The numbers of METHOD's row in an ampi eval depth table."""
+    for line in out.splitlines():
+        fields = line.split()
+        if fields and fields[0] == method:
+            return [float(x) for x in fields[1:6]]
+    sys.exit(f'make_tables.py: no {method} row in: {out}')
+
+
 def depth_table(ampi, count, threads):
     with tempfile.TemporaryDirectory(prefix='ampi-eval-depth-') as tmp:
-        subprocess.run([sys.executable, str(REPO / 'training' / 'make_eval_scenes.py'), tmp, '--count', str(count)],
-                       check=True, capture_output=True)
+        write_scenes(tmp, count)
         sections = []
         for model in ('lite', 'heavy'):
             command = [ampi, 'eval', 'depth', '--images', f'{tmp}/images', '--reference', f'{tmp}/reference',
@@ -59,13 +72,24 @@ def depth_table(ampi, count, threads):
         'the scenes (`ampi eval depth --help` has the exact definitions). `vertical-gradient` is',
         'a map that only grows towards the bottom of the image: the floor a network must beat.',
         '',
+        '| method | delta < 1.25 | delta < 1.25^2 | delta < 1.25^3 | RMSE | REL |',
+        '|---|---|---|---|---|---|',
     ]
+    for name, out in [(m, o) for m, _, o, _ in sections] + [('vertical-gradient', sections[0][2])]:
+        lines.append(f'| {name} | ' + ' | '.join(f'{v:.4f}' for v in first_row(out, name)) + ' |')
+    floor = first_row(sections[0][2], 'vertical-gradient')
+    for model, _, out, _ in sections:
+        row = first_row(out, model)
+        verdict = 'above' if row[0] > floor[0] and row[3] < floor[3] and row[4] < floor[4] else 'not above'
+        lines.append(f'\n{model}: {verdict} the vertical-gradient floor on all of delta < 1.25, RMSE and REL '
+                     f'(delta < 1.25 {row[0]:.4f} vs {floor[0]:.4f}).')
+    lines += ['', 'The outputs these rows are copied from:', '']
     for model, command, out, seconds in sections:
         lines += [f'## {model}', '', f'`{command}` ({seconds:.0f} s)', '', '```', out.rstrip(), '```', '']
     return '\n'.join(lines)
 
 
-def slicing_table(ampi, threads, extra):
+def slicing_table(ampi, threads, scene_count, extra):
     import scenes
     photos = scenes.list_photos('val')
     root = scenes.photo_root()
@@ -77,7 +101,20 @@ def slicing_table(ampi, threads, extra):
         command = [ampi, 'eval', 'slicing', '--images', tmp, '--threads', str(threads)] + extra
         out, seconds = run(command)
         command = shown(command).replace(tmp, 'VAL_PHOTOS')
+        example = Path(tmp) / photos[0].relative_to(root)
+        depth_png = Path(tmp) / 'example_depth.png'
+        run([ampi, 'depth', example, '-o', depth_png])
+        example_cuts = {kind: run([ampi, 'slice', depth_png, '--max-planes', '4'] + flag)[0]
+                        for kind, flag in (('adaptive', []), ('uniform', ['--uniform']))}
+        example_name = str(photos[0].relative_to(root))
+    with tempfile.TemporaryDirectory(prefix='ampi-eval-slicing-scenes-') as tmp:
+        write_scenes(tmp, scene_count)
+        exact_command = [ampi, 'eval', 'slicing', '--images', f'{tmp}/images', '--depth-dir', f'{tmp}/reference',
+                         '--threads', str(threads)] + extra
+        exact_out, exact_seconds = run(exact_command)
+        exact_command = shown(exact_command).replace(tmp, 'SCENES')
     verdict = [l for l in out.splitlines() if l.startswith('adaptive >= uniform at every count')]
+    exact_verdict = [l for l in exact_out.splitlines() if l.startswith('adaptive >= uniform at every count')]
     lines = [
         "# The paper's Table 3 on the validation photos (`ampi eval slicing`)",
         '',
@@ -100,7 +137,40 @@ def slicing_table(ampi, threads, extra):
         'its Table 3 itself uses RealEstate10K target frames, so the numbers are not comparable',
         'to the paper\'s (it reports SSIM 0.67-0.68, PSNR 18.7-19.0 dB).',
         '',
-        f'Target (issue 10): adaptive at or above uniform at every count. Result: {verdict[0] if verdict else "?"}.',
+        '## The same with exact depth',
+        '',
+        f'Whether the depth or the slicing is at fault: {scene_count} synthetic validation scenes',
+        f'(`training/make_eval_scenes.py SCENES --count {scene_count}`, as for RESULTS-depth-eval.md)',
+        'sliced with their exact disparity instead of the network\'s (`--depth-dir`):',
+        '',
+        f'`{exact_command}` ({exact_seconds:.0f} s)',
+        '',
+        '```',
+        exact_out.rstrip(),
+        '```',
+        '',
+        '## Why adaptive loses here',
+        '',
+        f'The planes of the first validation photo, `{example_name}`, with the lite network\'s depth',
+        f'(`ampi depth VAL_PHOTOS/{example_name} -o D.png`, then `ampi slice D.png --max-planes 4`',
+        'and the same with `--uniform`):',
+        '',
+        '```',
+        'adaptive:', example_cuts['adaptive'].rstrip(), 'uniform:', example_cuts['uniform'].rstrip(),
+        '```',
+        '',
+        'The transition index divides the histogram\'s Laplacian by the histogram itself, so it is',
+        'largest where few pixels are: the sparse far end of a smooth depth map draws the cuts,',
+        'and one plane is left holding most of the pixels over a wide disparity interval. A dense',
+        'reference penalises exactly that (every pixel of a plane moves with the plane\'s mean',
+        'disparity), while uniform intervals bound the error for every pixel. The paper measured',
+        'against real target frames, where artifacts at depth edges also count; against a dense MPI',
+        'from the same depth, what counts is mostly how far each pixel lands from where the dense',
+        'MPI puts it. On the synthetic scenes, exact depth alone does not reverse the result.',
+        '',
+        'Target (issue 10): adaptive at or above uniform at every count. Result on the',
+        f'validation photos: {verdict[0] if verdict else "?"}; with exact depth:',
+        f'{exact_verdict[0] if exact_verdict else "?"}.',
         '',
     ]
     return '\n'.join(lines)
@@ -111,14 +181,14 @@ def main(argv=None):
     parser.add_argument('table', choices=['depth', 'slicing'])
     parser.add_argument('--ampi', required=True, help='the ampi program')
     parser.add_argument('--threads', type=int, default=2)
-    parser.add_argument('--count', type=int, default=50, help='depth: synthetic scenes (default 50)')
+    parser.add_argument('--count', type=int, default=50, help='synthetic scenes (default 50)')
     parser.add_argument('--out', help='table file (default bench/RESULTS-depth-eval.md or bench/RESULTS-slicing.md)')
     args, extra = parser.parse_known_args(argv)
     ampi = str(Path(args.ampi).resolve())
     if args.table == 'depth':
         text = depth_table(ampi, args.count, args.threads)
     else:
-        text = slicing_table(ampi, args.threads, extra)
+        text = slicing_table(ampi, args.threads, args.count, extra)
     out = Path(args.out) if args.out else REPO / 'bench' / f'RESULTS-{"depth-eval" if args.table == "depth" else "slicing"}.md'
     out.write_text(text)
     print(f'wrote {out}')

@@ -31,7 +31,11 @@ namespace ampi {
 
 struct SlicingEvalOptions {
   std::vector<int> counts = {4, 8, 16};  // maximum plane counts of the adaptive slicer
-  int reference_planes = 64;             // planes of the dense uniform reference MPI
+  // Planes of the dense uniform reference MPI. 255: about one per level of the 8-bit
+  // normalised disparity, the densest MPI the slicers can make. Every cut either slicer
+  // makes is then one of the reference's, for adaptive and uniform alike; with 64, the
+  // uniform cuts at 4, 8 and 16 planes would all be the reference's, adaptive's mostly not.
+  int reference_planes = 255;
   int poses = 8;                         // target poses, evenly spaced on the circle
   double amplitude = 0.05;               // circle radius / nearest reference plane depth, in (0, 1)
   double fov_degrees = 60;               // assumed horizontal field of view
