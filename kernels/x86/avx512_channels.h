@@ -12,12 +12,18 @@ struct MaskedVector {
   __mmask16 mask;
   __m512 load(const float* p) const { return _mm512_maskz_loadu_ps(mask, p); }
   void store(float* p, __m512 v) const { _mm512_mask_storeu_ps(p, mask, v); }
+  __m512 splat(float x) const { return _mm512_set1_ps(x); }
 };
 
 struct FullVector {
   __m512 load(const float* p) const { return _mm512_loadu_ps(p); }
   void store(float* p, __m512 v) const { _mm512_storeu_ps(p, v); }
+  __m512 splat(float x) const { return _mm512_set1_ps(x); }
 };
+
+// The arithmetic lane-generic kernel bodies (kernels/*_lanes.inl) are written with.
+inline __m512 plus(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
+inline __m512 fmadd(__m512 a, __m512 b, __m512 c) { return _mm512_fmadd_ps(a, b, c); }
 
 class Channels {
  public:

@@ -1,0 +1,163 @@
+// Depthwise convolution row (DepthwiseRowArgs, kernels/kernel_table.h), written once for
+// AVX2, AVX-512 and NEON over the lane-generic channel helpers. Each ISA's
+// conv_depthwise_*.cpp includes this inside its own namespace, after its *_channels.h
+// (Channels, lane accessors, plus, fmadd) and *_math.h (activate). Not a header: no
+// include guard.
+//
+// Why it is shaped this way (bench/RESULTS-kernels.md has the numbers):
+// - The whole row goes in blocks of kBlock output pixels; one call per row walks every
+//   block and, inside each block, every channel vector. A block's accumulators, the
+//   current kernel row's weights and one input column fit in the register file, and
+//   kBlock independent FMA chains cover the FMA latency.
+// - With dilation 1 and the common kernel widths (3, 5) and strides (1, 2) fixed at
+//   compile time, each input column of a block is loaded once and feeds every
+//   (pixel, tap) pair that reads it: 10 loads for 24 FMAs per kernel row (3x3, stride 1).
+// - Blocks whose taps all fall inside the row load without bounds checks; the few
+//   border blocks (and the last, shorter one) load a zero for a column outside the row
+//   and store only their valid pixels, so the borders run the same vector code instead
+//   of a per-pixel, per-tap scalar path.
+// - The activation is a compile-time constant for the kinds the networks use, so the
+//   epilogue (bias is the accumulators' start value, activation, residual add, store)
+//   runs on the registers, in the same pass, without spilling the tile.
+// - Interior blocks prefetch the input row the next output row reads first, so the next
+//   call finds it in cache.
+
+namespace depthwise {
+constexpr int kBlock = 8;  // output pixels per block
+
+// Dilation 1 with kernel width K and stride S known at compile time.
+template <int K, int S>
+struct FixedGeometry {};
+// Any kernel width, stride and dilation, read from the arguments.
+struct AnyGeometry {};
+
+template <Activation kKind>
+struct FixedActivation {
+  float alpha;
+  template <class V>
+  V operator()(V v) const { return activate(v, ActivationSpec{kKind, alpha}); }
+};
+
+struct RuntimeActivation {
+  ActivationSpec spec;
+  template <class V>
+  V operator()(V v) const { return activate(v, spec); }
+};
+
+// Column ix of input row `row`, channels [ch, ch + lane width); zero outside the row
+// when kChecked.
+template <bool kChecked, class Lane>
+inline auto column(const DepthwiseRowArgs& d, const float* row, int ix, int ch, Lane lane) {
+  if constexpr (kChecked)
+    if (ix < 0 || ix >= d.in_w) return lane.splat(0.0f);
+  return lane.load(row + static_cast<int64_t>(ix) * d.channels + ch);
+}
+
+// acc[i] += the taps of output pixel i (input columns from ix0 + i*S), shared columns.
+template <bool kChecked, int K, int S, class Lane, class V>
+inline void accumulate(const DepthwiseRowArgs& d, FixedGeometry<K, S>, int ix0, int ch, Lane lane,
+                       V (&acc)[kBlock]) {
+  constexpr int kColumns = (kBlock - 1) * S + K;
+  const int64_t c = d.channels;
+  for (int ky = 0; ky < d.kernel_h; ++ky) {
+    const float* row = d.in_rows[ky];
+    if (!row) continue;
+    V w[K];
+    for (int kx = 0; kx < K; ++kx) w[kx] = lane.load(d.weights + (static_cast<int64_t>(ky) * K + kx) * c + ch);
+#pragma GCC unroll 32
+    for (int j = 0; j < kColumns; ++j) {
+      const V x = column<kChecked>(d, row, ix0 + j, ch, lane);
+#pragma GCC unroll 8
+      for (int kx = 0; kx < K; ++kx) {
+        const int offset = j - kx;  // = i * S for the pixel i reading column j at tap kx
+        if (offset >= 0 && offset % S == 0 && offset / S < kBlock)
+          acc[offset / S] = fmadd(w[kx], x, acc[offset / S]);
+      }
+    }
+  }
+}
+
+template <bool kChecked, class Lane, class V>
+inline void accumulate(const DepthwiseRowArgs& d, AnyGeometry, int ix0, int ch, Lane lane, V (&acc)[kBlock]) {
+  const int64_t c = d.channels;
+  for (int ky = 0; ky < d.kernel_h; ++ky) {
+    const float* row = d.in_rows[ky];
+    if (!row) continue;
+    for (int kx = 0; kx < d.kernel_w; ++kx) {
+      const V w = lane.load(d.weights + (static_cast<int64_t>(ky) * d.kernel_w + kx) * c + ch);
+      const int ix = ix0 + kx * d.dilation_w;
+      for (int i = 0; i < kBlock; ++i)
+        acc[i] = fmadd(w, column<kChecked>(d, row, ix + i * d.stride_w, ch, lane), acc[i]);
+    }
+  }
+}
+
+// Output pixels [ox, ox + count) of the row, channels [ch, ch + lane width): the
+// convolution, then act(acc) (+ residual), stored. count == kBlock unless kChecked.
+template <bool kChecked, class Geometry, class Act, class Lane>
+inline void block(const DepthwiseRowArgs& d, Geometry g, Act act, int ox, int count, int ch, Lane lane) {
+  using V = decltype(lane.load(d.bias));
+  const V bias = lane.load(d.bias + ch);
+  V acc[kBlock];
+  for (int i = 0; i < kBlock; ++i) acc[i] = bias;
+  accumulate<kChecked>(d, g, ox * d.stride_w - d.pad_left, ch, lane, acc);
+  const int64_t c = d.channels, first = static_cast<int64_t>(ox) * c + ch;
+  for (int i = 0; i < kBlock; ++i) {
+    if (kChecked && i >= count) break;
+    V v = act(acc[i]);
+    if (d.residual) v = plus(v, lane.load(d.residual + first + i * c));
+    lane.store(d.out + first + i * c, v);
+  }
+}
+
+// The input row the next output row reads first, at the columns of block ox: one
+// prefetch per 64-byte line.
+inline void prefetch_next_row(const DepthwiseRowArgs& d, int ox) {
+  if (!d.prefetch_row) return;
+  const int64_t c = d.channels;
+  const int64_t first = static_cast<int64_t>(ox * d.stride_w - d.pad_left) * c;
+  const int64_t last = std::min<int64_t>(first + static_cast<int64_t>(kBlock) * d.stride_w * c, int64_t{d.in_w} * c);
+  const float* begin = d.prefetch_row + first;
+  const float* end = d.prefetch_row + last;
+  for (const float* p = begin; p < end; p += 16) __builtin_prefetch(p);
+}
+
+template <class Geometry, class Act>
+void row(const DepthwiseRowArgs& d, Act act) {
+  const Channels channels(d.channels);
+  const Geometry g;
+  for (int ox = 0; ox < d.out_w; ox += kBlock) {
+    const int count = std::min(kBlock, d.out_w - ox);
+    if (count == kBlock && ox >= d.interior_begin && ox + kBlock <= d.interior_end) {
+      prefetch_next_row(d, ox);
+      channels.each([&](int ch, auto lane) { block<false>(d, g, act, ox, kBlock, ch, lane); });
+    } else {
+      channels.each([&](int ch, auto lane) { block<true>(d, g, act, ox, count, ch, lane); });
+    }
+  }
+}
+
+template <class Geometry>
+void row_for_activation(const DepthwiseRowArgs& d) {
+  const float alpha = d.act.alpha;
+  switch (d.act.kind) {
+    case Activation::None: return row<Geometry>(d, FixedActivation<Activation::None>{alpha});
+    case Activation::ReLU: return row<Geometry>(d, FixedActivation<Activation::ReLU>{alpha});
+    case Activation::ReLU6: return row<Geometry>(d, FixedActivation<Activation::ReLU6>{alpha});
+    case Activation::HardSwish: return row<Geometry>(d, FixedActivation<Activation::HardSwish>{alpha});
+    default: return row<Geometry>(d, RuntimeActivation{d.act});
+  }
+}
+
+}  // namespace depthwise
+
+void depthwise_row(const DepthwiseRowArgs& d) {
+  using namespace depthwise;
+  if (d.dilation_w == 1) {
+    if (d.kernel_w == 3 && d.stride_w == 1) return row_for_activation<FixedGeometry<3, 1>>(d);
+    if (d.kernel_w == 3 && d.stride_w == 2) return row_for_activation<FixedGeometry<3, 2>>(d);
+    if (d.kernel_w == 5 && d.stride_w == 1) return row_for_activation<FixedGeometry<5, 1>>(d);
+    if (d.kernel_w == 5 && d.stride_w == 2) return row_for_activation<FixedGeometry<5, 2>>(d);
+  }
+  row_for_activation<AnyGeometry>(d);
+}
