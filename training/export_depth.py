@@ -178,6 +178,46 @@ def import_ampw(path: str) -> depth_model.DepthNet:
     return model.eval()
 
 
+def unfold_batchnorm(model: depth_model.DepthNet, batches) -> depth_model.DepthNet:
+    """Makes a network imported from folded weights (import_ampw) trainable again.
+
+    Folding leaves every BatchNorm a pure shift, but training normalises with batch
+    statistics, which would change what the network computes. Each BatchNorm instead gets
+    the mean and variance of its input over `batches`, with gamma and beta chosen so that
+    in eval mode it still computes exactly the folded conv + bias; in training mode the
+    batch statistics then stay close to those. This is what lets a run continue from the
+    bundled .ampw (a new checkout has no checkpoint)."""
+    sums = {}
+
+    def record(bn, inputs, _output):
+        x = inputs[0].double()
+        s = sums.setdefault(bn, [0.0, 0.0, 0])
+        s[0] = s[0] + x.sum(dim=(0, 2, 3))
+        s[1] = s[1] + (x * x).sum(dim=(0, 2, 3))
+        s[2] += x.numel() // x.shape[1]
+
+    norms = [m for m in model.modules() if isinstance(m, nn.BatchNorm2d)]
+    hooks = [bn.register_forward_hook(record) for bn in norms]
+    model.eval()
+    with torch.no_grad():
+        for batch in batches:
+            model(batch)
+    for hook in hooks:
+        hook.remove()
+    with torch.no_grad():
+        for bn in norms:
+            total, squares, count = sums[bn]
+            mean = total / count
+            var = (squares / count - mean * mean).clamp_min(1e-8)
+            shift = bn.bias.double() - bn.weight.double() * bn.running_mean.double() / torch.sqrt(
+                bn.running_var.double() + bn.eps)  # what the folded BatchNorm adds now
+            bn.running_mean.copy_(mean)
+            bn.running_var.copy_(var)
+            bn.weight.copy_(torch.sqrt(var + bn.eps))
+            bn.bias.copy_(shift + mean)
+    return model
+
+
 def load_checkpoint(path: str):
     ckpt = torch.load(path, map_location="cpu")
     model = depth_model.build(ckpt["model_name"])

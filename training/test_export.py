@@ -43,6 +43,23 @@ class Export(unittest.TestCase):
                 err = float((a - b).abs().max())
                 self.assertLess(err, 1e-5 * max(scale, 1.0), f"seed {SEED}, output {i}: error {err}")
 
+    def test_unfolded_batchnorm_keeps_the_function_and_normalises_its_input(self):
+        torch.manual_seed(SEED)
+        model = randomised(depth_model.build("lite"), SEED)
+        g = torch.Generator().manual_seed(SEED)
+        batches = [torch.rand(2, 3, 64, 96, generator=g) for _ in range(3)]
+        rgb = torch.rand(1, 3, 64, 96, generator=g)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = str(Path(tmp) / "lite.ampw")
+            export_depth.export(model, path, {"steps": 0})
+            unfolded = export_depth.unfold_batchnorm(export_depth.import_ampw(path), batches)
+        with torch.no_grad():
+            for i, (a, b) in enumerate(zip(model(rgb), unfolded.eval()(rgb))):
+                err = float((a - b).abs().max())
+                self.assertLess(err, 1e-4 * max(float(a.abs().max()), 1.0), f"seed {SEED}, output {i}: error {err}")
+        first = unfolded.enc[0][0].bn
+        self.assertGreater(float((first.running_var - (1 - first.eps)).abs().max()), 1e-3)  # real statistics now
+
     def test_metadata_describes_the_graph(self):
         model = depth_model.build("lite")
         with tempfile.TemporaryDirectory() as tmp:

@@ -195,13 +195,33 @@ def parse_size(text: str):
     return w, h
 
 
+def initial_model(args, source, size, resuming: bool):
+    """The network to start from: new, or --init's weights (a checkpoint, or an exported
+    .ampw with its BatchNorms unfolded again), unless a checkpoint is about to be resumed."""
+    if not args.init or resuming:
+        return depth_model.build(args.model)
+    if not args.init.endswith(".ampw"):
+        model = depth_model.build(args.model)
+        model.load_state_dict(torch.load(args.init)["model"])
+        return model
+    import export_depth
+    model = export_depth.import_ampw(args.init)
+    if model.arch["name"] != args.model:
+        raise SystemExit(f"--init {args.init}: holds a {model.arch['name']} network, not {args.model}")
+    rng = random.Random(args.seed)
+    batches = [make_batch(source, VAL_SEED_START // 2 + i * args.batch, args.batch, False, rng)[0] for i in range(8)]
+    return export_depth.unfold_batchnorm(model, batches).train()
+
+
 def train(args):
     torch.set_num_threads(args.threads)
     torch.manual_seed(args.seed)
     run = Path(args.run)
     run.mkdir(parents=True, exist_ok=True)
     size = parse_size(args.size)
-    model = depth_model.build(args.model)
+    source = make_source(args.data, size)
+    ckpt_path = run / "checkpoint.pt"
+    model = initial_model(args, source, size, resuming=ckpt_path.exists())
     if size[0] % model.multiple or size[1] % model.multiple:
         raise SystemExit(f"--size {args.size}: both sides must be multiples of {model.multiple}")
     model = model.to(memory_format=torch.channels_last)
@@ -209,7 +229,6 @@ def train(args):
     scheduler = torch.optim.lr_scheduler.ReduceLROnPlateau(
         optimiser, factor=0.2, patience=args.patience)
     step, best = 0, math.inf
-    ckpt_path = run / "checkpoint.pt"
     if ckpt_path.exists():
         ckpt = torch.load(ckpt_path)
         if ckpt["model_name"] != args.model:
@@ -220,9 +239,7 @@ def train(args):
         step, best = ckpt["step"], ckpt["best_val"]
         log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}")
     elif args.init:
-        model.load_state_dict(torch.load(args.init)["model"])
         log_line(run, f"initialised {args.model} from {args.init}")
-    source = make_source(args.data, size)
     val_count = source.validation_count(args.val_count)
     log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data} "
                   f"at {size[0]}x{size[1]}, batch {args.batch}, {args.threads} threads")
