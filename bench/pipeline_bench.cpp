@@ -1,6 +1,5 @@
-// ampi bench pipeline: where the time of `ampi run` goes, stage by stage, and the peak
-// memory, at 1024x768 and at 4K, on the bundled example photo resized to each size.
-#include <sys/resource.h>
+// ampi bench pipeline: where the time and the memory of `ampi run` go, stage by stage,
+// at 1024x768 and at 4K, on the bundled example photo resized to each size.
 #include <unistd.h>
 
 #include <algorithm>
@@ -13,6 +12,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "bench/bench.h"
@@ -35,7 +35,8 @@ const char kUsage[] =
     "\n"
     "Times every stage of `ampi run` (decode, depth, slicing, assembly, inpainting, MPI\n"
     "write, render + encode of the video) on PHOTO resized to 1024x768 and to 3840x2160,\n"
-    "medians of N runs, and the process's peak resident memory after each size. Writes the\n"
+    "medians of N runs, and each stage's peak resident memory. Also slicing's time as a\n"
+    "share of the depth network's (both run at the same working resolution). Writes the\n"
     "table to bench/RESULTS-pipeline.md.\n"
     "\n"
     "  --photo FILE   default examples/forest_path.jpg\n"
@@ -46,12 +47,6 @@ const char kUsage[] =
     "  --working-size N      the depth network's long side (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
-double peak_rss_mb() {
-  struct rusage usage;
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes
-}
-
 double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
@@ -61,22 +56,33 @@ struct SizeResult {
   cv::Size size;
   std::vector<std::string> stages;             // in pipeline order
   std::map<std::string, std::vector<double>> ms;  // per stage, one value per run
-  double peak_mb = 0;
+  std::map<std::string, double> stage_peak_mb;    // per stage, the largest over all runs
+  double peak_mb = 0;                             // the largest of any stage
   size_t planes = 0;
+  cv::Size slicing_size;  // where the depth network's output was sliced
 };
 
-// One `ampi run` worth of work on `photo_file`, timed by stage into `progress`.
-size_t run_once(MpiMaker& maker, const std::string& photo_file, const fs::path& scratch,
-                const VideoOptions& video, Progress& progress) {
-  const cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo_file); });
-  const MpiResult result = maker.make(bgr, photo_file, progress);
+struct RunOutcome {
+  size_t planes = 0;
+  cv::Size slicing_size;
+};
+
+// One `ampi run` worth of work on `photo_file`, timed by stage into `progress`, letting
+// buffers go where `ampi run` does.
+RunOutcome run_once(MpiMaker& maker, const std::string& photo_file, const fs::path& scratch,
+                    const VideoOptions& video, Progress& progress) {
+  cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo_file); });
+  MpiResult result = maker.make(bgr, photo_file, progress);
+  bgr.release();
+  const RunOutcome outcome{result.mpi.planes.size(), result.slicing_size};
   fs::remove_all(scratch / "mpi");
   fs::remove_all(scratch / "video.mp4");
   progress.stage("write mpi", [&] { write_mpi(result.mpi, (scratch / "mpi").string()); });
+  result.disparity.release();
   progress.stage("render+encode", [&] {
-    return write_video(result.mpi, video, (scratch / "video.mp4").string(), false);
+    return write_video(std::move(result.mpi), video, (scratch / "video.mp4").string(), false);
   });
-  return result.mpi.planes.size();
+  return outcome;
 }
 
 SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOptions& options,
@@ -90,17 +96,37 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
     throw std::runtime_error(photo_file + ": cannot write the benchmark photo");
   MpiMaker maker{options};
   for (int k = 0; k <= runs; ++k) {  // run 0 loads the networks and warms the caches
-    Progress progress(true);
-    r.planes = run_once(maker, photo_file, scratch, video, progress);
+    Progress progress(/*quiet=*/true, /*measure_memory=*/true);
+    const RunOutcome outcome = run_once(maker, photo_file, scratch, video, progress);
+    r.planes = outcome.planes;
+    r.slicing_size = outcome.slicing_size;
+    // Memory counts every run, the one that loads the networks included.
+    for (const auto& [stage, mb] : progress.peaks_mb()) {
+      r.stage_peak_mb[stage] = std::max(r.stage_peak_mb[stage], mb);
+      r.peak_mb = std::max(r.peak_mb, mb);
+    }
     if (k == 0) continue;
     for (const auto& [stage, ms] : progress.times_ms()) {
       if (!r.ms.count(stage)) r.stages.push_back(stage);
       r.ms[stage].push_back(ms);
     }
   }
-  r.peak_mb = peak_rss_mb();
   return r;
 }
+
+std::string cell(const char* format, double value) {
+  char text[48];
+  std::snprintf(text, sizeof text, format, value);
+  return text;
+}
+
+double median_of(const SizeResult& r, const std::string& stage) {
+  return r.ms.count(stage) ? median(r.ms.at(stage)) : 0;
+}
+
+// Issue 6's target: slicing costs at most this share of the depth network's time at the
+// same resolution.
+constexpr double kSlicingShareTarget = 0.05;
 
 std::string table(const std::vector<SizeResult>& results, const MpiOptions& options, int threads,
                   int frames, int runs) {
@@ -108,42 +134,48 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
   md << "# Pipeline benchmark\n\n"
      << "`ampi bench pipeline`: the stages of `ampi run` on the bundled example photo resized\n"
      << "to each size, " << threads << " threads, median of " << runs << " runs after a warm-up run;\n"
-     << "the video is " << frames << " frames. Peak memory is the process's maximum resident\n"
-     << "set after all runs at that size (sizes run smallest first, so each includes the\n"
-     << "ones before). Inpainting: " << (options.network_inpainting ? "the network" : "push-pull")
-     << "; depth network's long side: "
+     << "the video is " << frames << " frames. Peak memory: the process's maximum resident set\n"
+     << "while the stage ran (its peak is reset as each stage starts), the largest over all runs,\n"
+     << "the warm-up that loads the networks included. Inpainting: "
+     << (options.network_inpainting ? "the network" : "push-pull") << "; depth network's long side: "
      << (options.working_size ? std::to_string(options.working_size) : std::string("the weight file's"))
      << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"
      << "| stage |";
-  for (const SizeResult& r : results) md << " " << r.size.width << "x" << r.size.height << " (ms) |";
+  for (const SizeResult& r : results)
+    md << " " << r.size.width << "x" << r.size.height << " (ms) | peak (MB) |";
   md << "\n|---|";
-  for (size_t i = 0; i < results.size(); ++i) md << "---:|";
+  for (size_t i = 0; i < results.size(); ++i) md << "---:|---:|";
   md << "\n";
   for (const std::string& stage : results.front().stages) {
     md << "| " << stage << " |";
-    for (const SizeResult& r : results) {
-      char cell[32];
-      std::snprintf(cell, sizeof cell, " %.0f |", median(r.ms.count(stage) ? r.ms.at(stage) : std::vector<double>{}));
-      md << cell;
-    }
+    for (const SizeResult& r : results)
+      md << cell(" %.0f |", median_of(r, stage))
+         << cell(" %.0f |", r.stage_peak_mb.count(stage) ? r.stage_peak_mb.at(stage) : 0);
     md << "\n";
   }
   const char* to_mpi[] = {"decode", "depth", "slicing", "assembly", "inpainting"};
   md << "| **photo to MPI** (decode..inpainting) |";
   for (const SizeResult& r : results) {
-    double sum = 0;
-    for (const char* s : to_mpi) sum += r.ms.count(s) ? median(r.ms.at(s)) : 0;
-    char cell[32];
-    std::snprintf(cell, sizeof cell, " **%.0f** |", sum);
-    md << cell;
+    double sum = 0, peak = 0;
+    for (const char* s : to_mpi) {
+      sum += median_of(r, s);
+      if (r.stage_peak_mb.count(s)) peak = std::max(peak, r.stage_peak_mb.at(s));
+    }
+    md << cell(" **%.0f** |", sum) << cell(" %.0f |", peak);
   }
+  md << "\n| **whole run** (peak of any stage) |";
+  for (const SizeResult& r : results) md << " |" << cell(" **%.0f** |", r.peak_mb);
   md << "\n| planes |";
-  for (const SizeResult& r : results) md << " " << r.planes << " |";
-  md << "\n| peak memory (MB) |";
+  for (const SizeResult& r : results) md << " " << r.planes << " | |";
+  // The slicer runs on the depth network's output, so both work at the same resolution;
+  // the depth stage also includes shrinking the photo to it.
+  md << "\n| depth and slicing ran at |";
+  for (const SizeResult& r : results)
+    md << " " << r.slicing_size.width << "x" << r.slicing_size.height << " | |";
+  md << "\n| slicing / depth (target <= " << cell("%.0f", 100 * kSlicingShareTarget) << "%) |";
   for (const SizeResult& r : results) {
-    char cell[32];
-    std::snprintf(cell, sizeof cell, " %.0f |", r.peak_mb);
-    md << cell;
+    const double depth = median_of(r, "depth"), share = depth > 0 ? median_of(r, "slicing") / depth : 0;
+    md << cell(" %.1f%%", 100 * share) << (share <= kSlicingShareTarget ? " (met)" : " (not met)") << " | |";
   }
   md << "\n";
   return md.str();

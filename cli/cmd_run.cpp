@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "cli/args.h"
@@ -157,21 +158,25 @@ std::vector<std::string> expand_inputs(const std::vector<std::string>& inputs) {
 void run_one(MpiMaker& maker, const RunArgs& a, const std::string& photo,
              const std::string& destination, Progress& progress) {
   OutputStaging staging(destination, a.force);
-  const cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo); });
-  const MpiResult result = maker.make(bgr, photo, progress);
+  cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo); });
+  MpiResult result = maker.make(bgr, photo, progress);
+  bgr.release();  // each buffer is let go once no later stage needs it (peak memory)
   progress.stage("write mpi", [&] {
     const fs::path dir(staging.dir());
     write_depth_png16(result.disparity, (dir / "depth.png").string());
     write_mpi(result.mpi, (dir / "mpi").string());
   });
+  result.disparity.release();
+  const size_t planes = result.mpi.planes.size();
+  // The viewer before the video: the video consumes the layers.
+  progress.stage("viewer", [&] { return write_viewer(result.mpi, staging.dir()); });
   if (a.video)
     progress.stage("video", [&] {
       const fs::path file = fs::path(staging.dir()) / video_file_name(a.video_options.container);
-      return write_video(result.mpi, a.video_options, file.string(), false);
+      return write_video(std::move(result.mpi), a.video_options, file.string(), false);
     });
-  progress.stage("viewer", [&] { return write_viewer(result.mpi, staging.dir()); });
   staging.commit();
-  progress.note(photo + ": " + std::to_string(result.mpi.planes.size()) + " planes, inpainted by " +
+  progress.note(photo + ": " + std::to_string(planes) + " planes, inpainted by " +
                 result.inpainter + " -> " + destination);
 }
 

@@ -88,6 +88,7 @@ MpiResult MpiMaker::make(const cv::Mat& bgr, const std::string& photo_path, Prog
                                               options_.working_size ? options_.working_size : 1024);
     if (work.width != disparity.cols || work.height != disparity.rows)
       cv::resize(disparity, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+    result.slicing_size = small.size();
     return options_.uniform
                ? slice_uniform(small, options_.slicing.max_planes, options_.slicing.range)
                : slice_adaptive(small, options_.slicing);

@@ -36,6 +36,7 @@ struct MpiResult {
   cv::Mat disparity;  // CV_32FC1 at the photo's size, larger = nearer
   Mpi mpi;            // inpainted
   std::string inpainter;  // which filler ran: "network" or "push-pull"
+  cv::Size slicing_size;  // the map the slicer ran on (the depth network's working size)
 };
 
 // Holds what is loaded once and reused across photos (the networks).

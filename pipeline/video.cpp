@@ -53,23 +53,50 @@ double overscan_zoom(const Mpi& mpi, const std::vector<Pose>& poses) {
   return zoom;
 }
 
-int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
-                bool overwrite, ThreadPool& pool) {
+namespace {
+
+// The path's poses, zoomed for overscan when asked.
+std::vector<Pose> video_poses(const Mpi& mpi, const VideoOptions& options) {
   std::vector<Pose> poses =
       options.keyframes.empty()
           ? camera_path(options.path, mpi.planes)
           : keyframe_path(read_keyframes(options.keyframes), options.path.fps);
-  // Relative to the nearest plane, so the stereo budget is the same whatever the scale.
-  const double baseline = options.baseline * mpi.planes.back().depth;
   if (options.overscan) {
     const double zoom = overscan_zoom(mpi, poses);
     for (Pose& pose : poses) pose.zoom *= zoom;
   }
-  const Renderer renderer(mpi);
+  return poses;
+}
+
+int render_video(const Renderer& renderer, const std::vector<Pose>& poses, double baseline,
+                 const VideoOptions& options, const std::string& path, bool overwrite,
+                 ThreadPool& pool) {
   FrameWriter writer(path, options.container, options.path.fps, overwrite);
   render_frames(renderer, poses, options.stereo, baseline, writer, pool);
   writer.finish();
   return writer.frames();
+}
+
+// Relative to the nearest plane, so the stereo budget is the same whatever the scale.
+double stereo_baseline(const Mpi& mpi, const VideoOptions& options) {
+  return options.baseline * mpi.planes.back().depth;
+}
+
+}  // namespace
+
+int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
+                bool overwrite, ThreadPool& pool) {
+  const std::vector<Pose> poses = video_poses(mpi, options);
+  const Renderer renderer(mpi);
+  return render_video(renderer, poses, stereo_baseline(mpi, options), options, path, overwrite, pool);
+}
+
+int write_video(Mpi&& mpi, const VideoOptions& options, const std::string& path, bool overwrite,
+                ThreadPool& pool) {
+  const std::vector<Pose> poses = video_poses(mpi, options);
+  const Renderer renderer(mpi);
+  std::vector<cv::Mat>().swap(mpi.layers);  // the renderer has its own copy
+  return render_video(renderer, poses, stereo_baseline(mpi, options), options, path, overwrite, pool);
 }
 
 }  // namespace ampi
