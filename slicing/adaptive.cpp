@@ -1,6 +1,7 @@
 #include "slicing/adaptive.h"
 
 #include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
@@ -14,7 +15,10 @@ void check_disparity(const cv::Mat& disparity) {
   if (disparity.empty()) throw std::invalid_argument("slicing: the disparity map is empty");
   if (disparity.type() != CV_32FC1)
     throw std::invalid_argument("slicing: the disparity map must be CV_32FC1 (one float channel)");
-  if (!cv::checkRange(disparity, true))
+  // A finite sum proves every value finite (a NaN or an infinity would spread to it) in
+  // one fast pass; only a sum that is not (extreme values overflow OpenCV's partial
+  // sums) needs checkRange's slower look.
+  if (!std::isfinite(cv::sum(disparity)[0]) && !cv::checkRange(disparity, true))
     throw std::invalid_argument("slicing: the disparity map contains NaN or infinite values");
 }
 
@@ -29,23 +33,6 @@ void check_params(const SlicingParams& p) {
   require(p.bilateral_sigma_color > 0 && p.bilateral_sigma_space > 0, "bilateral sigmas must be positive");
   require(p.canny_low >= 0 && p.canny_high >= p.canny_low, "Canny thresholds must satisfy 0 <= low <= high");
   require(p.border_erosion_size >= 1, "border_erosion_size must be at least 1");
-}
-
-std::vector<double> normalized_histogram(const cv::Mat& levels, const cv::Mat& excluded) {
-  std::vector<double> h(kDisparityLevels, 0.0);
-  long long total = 0;
-  for (int y = 0; y < levels.rows; ++y) {
-    const uchar* level = levels.ptr<uchar>(y);
-    const uchar* skip = excluded.empty() ? nullptr : excluded.ptr<uchar>(y);
-    for (int x = 0; x < levels.cols; ++x) {
-      if (skip && skip[x]) continue;
-      h[level[x]] += 1.0;
-      ++total;
-    }
-  }
-  if (total > 0)
-    for (double& v : h) v /= static_cast<double>(total);
-  return h;
 }
 
 // Mass of h over the levels [lo, end), from prefix sums (prefix[i] = h[0] + .. + h[i-1]).
@@ -87,8 +74,8 @@ std::vector<double> slicing_histogram(const cv::Mat& normalized, const SlicingPa
   const cv::Mat element = cv::getStructuringElement(
       cv::MORPH_RECT, cv::Size(p.border_erosion_size, p.border_erosion_size));
   cv::dilate(edges, band, element);
-  std::vector<double> h = normalized_histogram(filtered, band);
-  if (static_cast<size_t>(cv::countNonZero(band)) == band.total()) h = normalized_histogram(filtered, cv::Mat());
+  std::vector<double> h = level_histogram(filtered, band);
+  if (static_cast<size_t>(cv::countNonZero(band)) == band.total()) h = level_histogram(filtered, cv::Mat());
   return h;
 }
 

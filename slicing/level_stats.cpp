@@ -19,6 +19,60 @@ LevelStats level_stats(const cv::Mat& normalized, const cv::Mat& normalized_floa
   return s;
 }
 
+std::vector<double> level_histogram_reference(const cv::Mat& levels, const cv::Mat& excluded) {
+  std::vector<double> h(kDisparityLevels, 0.0);
+  long long total = 0;
+  for (int y = 0; y < levels.rows; ++y) {
+    const uchar* level = levels.ptr<uchar>(y);
+    const uchar* skip = excluded.empty() ? nullptr : excluded.ptr<uchar>(y);
+    for (int x = 0; x < levels.cols; ++x) {
+      if (skip && skip[x]) continue;
+      h[level[x]] += 1.0;
+      ++total;
+    }
+  }
+  if (total > 0)
+    for (double& v : h) v /= static_cast<double>(total);
+  return h;
+}
+
+std::vector<double> level_histogram(const cv::Mat& levels, const cv::Mat& excluded) {
+  CV_Assert(levels.type() == CV_8UC1 && (excluded.empty() || (excluded.type() == CV_8UC1 &&
+                                                                excluded.size() == levels.size())));
+  // Four tables, pixel x counted in table x % 4: neighbours, which mostly share a level,
+  // then increment different counters instead of waiting on one.
+  // Each table has one bin more, where excluded pixels go.
+  constexpr int kTables = 4, kBins = kDisparityLevels + 1;
+  std::vector<long long> table(kTables * kBins, 0);
+  long long* t[kTables] = {&table[0], &table[kBins], &table[2 * kBins], &table[3 * kBins]};
+  for (int y = 0; y < levels.rows; ++y) {
+    const uchar* level = levels.ptr<uchar>(y);
+    const uchar* skip = excluded.empty() ? nullptr : excluded.ptr<uchar>(y);
+    int x = 0;
+    if (skip) {
+      // An excluded pixel is counted in a bin past the histogram's end: no branch.
+      for (; x + kTables <= levels.cols; x += kTables)
+        for (int k = 0; k < kTables; ++k) ++t[k][skip[x + k] ? kDisparityLevels : level[x + k]];
+      for (; x < levels.cols; ++x) ++t[0][skip[x] ? kDisparityLevels : level[x]];
+    } else {
+      for (; x + kTables <= levels.cols; x += kTables)
+        for (int k = 0; k < kTables; ++k) ++t[k][level[x + k]];
+      for (; x < levels.cols; ++x) ++t[0][level[x]];
+    }
+  }
+  std::vector<double> h(kDisparityLevels, 0.0);
+  long long total = 0;
+  for (int i = 0; i < kDisparityLevels; ++i) {
+    long long n = 0;
+    for (int k = 0; k < kTables; ++k) n += t[k][i];
+    h[i] = static_cast<double>(n);
+    total += n;
+  }
+  if (total > 0)
+    for (double& v : h) v /= static_cast<double>(total);
+  return h;
+}
+
 Plane plane_for_interval(const LevelStats& stats, int lo, int hi, const DepthRange& range) {
   const int end = interval_end(hi);
   long long n = 0;
