@@ -20,6 +20,7 @@
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
 #include "nets/weights_path.h"
+#include "pipeline/full_resolution.h"
 #include "pipeline/make_mpi.h"
 #include "pipeline/photo_io.h"
 #include "pipeline/video.h"
@@ -77,8 +78,9 @@ RunOutcome run_once(MpiMaker& maker, const std::string& photo_file, const fs::pa
   const RunOutcome outcome{result.mpi.planes.size(), result.slicing_size};
   fs::remove_all(scratch / "mpi");
   fs::remove_all(scratch / "video.mp4");
-  progress.stage("write mpi", [&] { write_mpi(result.mpi, (scratch / "mpi").string()); });
+  progress.stage("write mpi", [&] { write_mpi_at_photo_size(result, (scratch / "mpi").string()); });
   result.disparity.release();
+  result.full_bgr.release();
   progress.stage("render+encode", [&] {
     return write_video(std::move(result.mpi), video, (scratch / "video.mp4").string(), false);
   });
@@ -94,6 +96,7 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
   const std::string photo_file = (scratch / "photo.jpg").string();
   if (!cv::imwrite(photo_file, resized, {cv::IMWRITE_JPEG_QUALITY, 92}))
     throw std::runtime_error(photo_file + ": cannot write the benchmark photo");
+  resized.release();  // not held through the runs, whose memory is measured
   MpiMaker maker{options};
   for (int k = 0; k <= runs; ++k) {  // run 0 loads the networks and warms the caches
     Progress progress(/*quiet=*/true, /*measure_memory=*/true);
@@ -153,7 +156,7 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
          << cell(" %.0f |", r.stage_peak_mb.count(stage) ? r.stage_peak_mb.at(stage) : 0);
     md << "\n";
   }
-  const char* to_mpi[] = {"decode", "depth", "slicing", "assembly", "inpainting"};
+  const char* to_mpi[] = {"decode", "reduce", "depth", "slicing", "assembly", "inpainting"};
   md << "| **photo to MPI** (decode..inpainting) |";
   for (const SizeResult& r : results) {
     double sum = 0, peak = 0;

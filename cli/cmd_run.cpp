@@ -15,6 +15,7 @@
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
 #include "pipeline/depth_io.h"
+#include "pipeline/full_resolution.h"
 #include "pipeline/make_mpi.h"
 #include "pipeline/output_staging.h"
 #include "pipeline/photo_io.h"
@@ -161,12 +162,17 @@ void run_one(MpiMaker& maker, const RunArgs& a, const std::string& photo,
   cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo); });
   MpiResult result = maker.make(bgr, photo, progress);
   bgr.release();  // each buffer is let go once no later stage needs it (peak memory)
+  if (is_reduced(result))
+    progress.note(photo + ": " + std::to_string(result.full_bgr.cols) + "x" + std::to_string(result.full_bgr.rows) +
+                  " is made into an MPI at " + std::to_string(result.mpi.camera.width) + "x" +
+                  std::to_string(result.mpi.camera.height) + " (video and viewer too); the layers are written at full size");
   progress.stage("write mpi", [&] {
     const fs::path dir(staging.dir());
-    write_depth_png16(result.disparity, (dir / "depth.png").string());
-    write_mpi(result.mpi, (dir / "mpi").string());
+    write_depth_png16(disparity_at_photo_size(result), (dir / "depth.png").string());
+    write_mpi_at_photo_size(result, (dir / "mpi").string());
   });
   result.disparity.release();
+  result.full_bgr.release();
   const size_t planes = result.mpi.planes.size();
   // The viewer before the video: the video consumes the layers.
   progress.stage("viewer", [&] { return write_viewer(result.mpi, staging.dir()); });

@@ -216,22 +216,31 @@ void write_mpi(const Mpi& mpi, const std::string& dir) {
   check_description(mpi, dir);
   if (mpi.layers.size() != mpi.planes.size())
     fail(dir, std::to_string(mpi.layers.size()) + " layers for " + std::to_string(mpi.planes.size()) + " planes");
-  std::vector<std::string> names;
-  for (size_t j = 0; j < mpi.layers.size(); ++j) {
-    names.push_back(layer_name(j));
-    check_layer(mpi.layers[j], mpi.camera, (fs::path(dir) / names.back()).string());
-  }
+  for (size_t j = 0; j < mpi.layers.size(); ++j)  // every layer checked before any file is written
+    check_layer(mpi.layers[j], mpi.camera, (fs::path(dir) / layer_name(j)).string());
+  write_mpi_streamed(mpi, [&](size_t j) { return mpi.layers[j]; }, dir);
+}
+
+void write_mpi_streamed(const Mpi& description, const std::function<cv::Mat(size_t)>& layer,
+                        const std::string& dir) {
+  check_description(description, dir);
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (!fs::is_directory(dir)) fail(dir, "cannot create the folder" + (ec ? " (" + ec.message() + ")" : std::string()));
-  for (size_t j = 0; j < mpi.layers.size(); ++j) {
+  std::vector<std::string> names;
+  for (size_t j = 0; j < description.planes.size(); ++j) {
+    names.push_back(layer_name(j));
+    const std::string path = (fs::path(dir) / names.back()).string();
     std::vector<unsigned char> png;
-    const std::string path = (fs::path(dir) / names[j]).string();
-    if (!cv::imencode(".png", mpi.layers[j], png)) fail(path, "PNG encoding failed");
+    {
+      const cv::Mat image = layer(j);
+      check_layer(image, description.camera, path);
+      if (!cv::imencode(".png", image, png)) fail(path, "PNG encoding failed");
+    }
     write_file_atomic(path, png);
   }
   // The description goes last: a reader never finds one whose layers are not there yet.
-  const std::string json = description_json(mpi, names);
+  const std::string json = description_json(description, names);
   write_file_atomic((fs::path(dir) / "mpi.json").string(), std::vector<unsigned char>(json.begin(), json.end()));
 }
 

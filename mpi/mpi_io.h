@@ -11,6 +11,7 @@
 // normalised disparity 0..255, interval the normalised disparities it was cut from
 // (see slicing/adaptive.h), pixels how many source pixels it took.
 #pragma once
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -25,6 +26,12 @@ constexpr int kMpiFormatVersion = 1;
 // in `dir` is deleted. Throws std::runtime_error "PATH: problem" for an inconsistent Mpi
 // or a file that cannot be written.
 void write_mpi(const Mpi& mpi, const std::string& dir);
+
+// The same for an MPI too large to hold at once: `description` (camera, range, planes;
+// its layers are ignored) and layer(j), called once per plane in order, each layer
+// encoded and dropped before the next is made.
+void write_mpi_streamed(const Mpi& description, const std::function<cv::Mat(size_t)>& layer,
+                        const std::string& dir);
 
 // Reads and validates an MPI folder. Every problem (missing folder or mpi.json,
 // malformed JSON, other format or version, missing or ill-typed field, plane count

@@ -33,16 +33,18 @@ MpiMaker::MpiMaker(MpiOptions options) : options_(std::move(options)) {
 
 MpiMaker::~MpiMaker() = default;
 
-cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, const std::string& photo_path,
+cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, cv::Size photo_size, const std::string& photo_path,
                                     Progress& progress) {
   if (!options_.depth_file.empty()) {
     cv::Mat disparity = progress.stage("depth (file)", [&] {
       return read_depth_map(options_.depth_file, options_.depth_is_distance);
     });
-    if (disparity.size() != bgr.size())
+    if (disparity.size() != photo_size)
       throw std::runtime_error(options_.depth_file + ": depth map is " + std::to_string(disparity.cols) +
                                "x" + std::to_string(disparity.rows) + " but the photo " + photo_path +
-                               " is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows));
+                               " is " + std::to_string(photo_size.width) + "x" + std::to_string(photo_size.height));
+    if (disparity.size() != bgr.size())  // a reduced photo: the map is reduced with it
+      cv::resize(disparity, disparity, bgr.size(), 0, 0, cv::INTER_AREA);
     return disparity;
   }
   if (!depth_net_) {
@@ -71,15 +73,27 @@ LayerFiller& MpiMaker::filler() {
   return *filler_;
 }
 
-MpiResult MpiMaker::make(const cv::Mat& bgr, const std::string& photo_path, Progress& progress) {
+MpiResult MpiMaker::make(const cv::Mat& photo, const std::string& photo_path, Progress& progress) {
+  MpiResult result;
+  cv::Mat bgr = photo;
+  const int cap = options_.max_working_side;
+  if (cap > 0 && std::max(photo.cols, photo.rows) > cap) {
+    result.full_bgr = photo;
+    result.full_camera = camera_from_fov(photo.cols, photo.rows, options_.fov_degrees);
+    bgr = progress.stage("reduce", [&] {
+      const ImageSize work = depth_working_size(photo.rows, photo.cols, cap);
+      cv::Mat reduced;
+      cv::resize(photo, reduced, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+      return reduced;
+    });
+  }
   // The layers are the run's largest buffers: a photo they would not fit in memory is
   // refused before any work is done.
   const int layers = options_.slicing.max_planes;
   check_allocation(bytes_for({uint64_t(layers), uint64_t(bgr.cols), uint64_t(bgr.rows), 4}), photo_path,
                    std::to_string(layers) + " RGBA layers at " + std::to_string(bgr.cols) + "x" +
                        std::to_string(bgr.rows));
-  MpiResult result;
-  const cv::Mat disparity = working_disparity(bgr, photo_path, progress);
+  const cv::Mat disparity = working_disparity(bgr, photo.size(), photo_path, progress);
   // Slice at the working resolution (the histogram needs no more pixels), cut the
   // layers at the photo's own resolution.
   std::vector<Plane> planes = progress.stage("slicing", [&] {

@@ -30,13 +30,23 @@ struct MpiOptions {
   bool network_inpainting = false;
   std::string inpaint_weights;       // the network's weight file instead of the bundled one
   double fov_degrees = 60;           // assumed horizontal field of view of the photo
+  // A photo whose long side is larger is made into an MPI at this size (depth,
+  // slicing, layers, inpainting, and the video and viewer drawn from them), and only its
+  // written layers are at the photo's full resolution, made one at a time
+  // (pipeline/full_resolution.h): memory stays that of a photo this size plus a few
+  // bytes per photo pixel. 0: no cap.
+  int max_working_side = 4096;
 };
 
 struct MpiResult {
-  cv::Mat disparity;  // CV_32FC1 at the photo's size, larger = nearer
-  Mpi mpi;            // inpainted
+  cv::Mat disparity;  // CV_32FC1 at the MPI's size, larger = nearer
+  Mpi mpi;            // inpainted; at the photo's size unless the photo was reduced
   std::string inpainter;  // which filler ran: "network" or "push-pull"
   cv::Size slicing_size;  // the map the slicer ran on (the depth network's working size)
+  // Set only when the photo was larger than max_working_side: the photo itself and its
+  // camera, from which full_resolution.h makes the written layers.
+  cv::Mat full_bgr;
+  Camera full_camera;
 };
 
 // Holds what is loaded once and reused across photos (the networks).
@@ -50,7 +60,8 @@ class MpiMaker {
   MpiResult make(const cv::Mat& bgr, const std::string& photo_path, Progress& progress);
 
  private:
-  cv::Mat working_disparity(const cv::Mat& bgr, const std::string& photo_path, Progress& progress);
+  cv::Mat working_disparity(const cv::Mat& bgr, cv::Size photo_size, const std::string& photo_path,
+                            Progress& progress);
   LayerFiller& filler();
 
   MpiOptions options_;
