@@ -35,7 +35,7 @@ struct MpiOptions {
   // written layers are at the photo's full resolution, made one at a time
   // (pipeline/full_resolution.h): memory stays that of a photo this size plus a few
   // bytes per photo pixel. 0: no cap.
-  int max_working_side = 4096;
+  int max_working_side = 3840;
 };
 
 struct MpiResult {
