@@ -84,6 +84,7 @@ RunOutcome run_once(MpiMaker& maker, const std::string& photo_file, const fs::pa
   progress.stage("render+encode", [&] {
     return write_video(std::move(result.mpi), video, (scratch / "video.mp4").string(), false);
   });
+  release_free_memory();
   return outcome;
 }
 
@@ -139,7 +140,9 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
      << "to each size, " << threads << " threads, median of " << runs << " runs after a warm-up run;\n"
      << "the video is " << frames << " frames. Peak memory: the process's maximum resident set\n"
      << "while the stage ran (its peak is reset as each stage starts), the largest over all runs,\n"
-     << "the warm-up that loads the networks included. Inpainting: "
+     << "the warm-up that loads the networks included. As in `ampi run`, the heap's free\n"
+     << "memory is handed back to the system after each photo and after any stage that leaves\n"
+     << "64 MB or more free (pipeline/progress.h), outside the stage times. Inpainting: "
      << (options.network_inpainting ? "the network" : "push-pull") << "; depth network's long side: "
      << (options.working_size ? std::to_string(options.working_size) : std::string("the weight file's"))
      << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"

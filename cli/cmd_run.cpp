@@ -19,6 +19,7 @@
 #include "pipeline/make_mpi.h"
 #include "pipeline/output_staging.h"
 #include "pipeline/photo_io.h"
+#include "pipeline/progress.h"
 #include "pipeline/video.h"
 #include "render/viewer.h"
 
@@ -182,6 +183,7 @@ void run_one(MpiMaker& maker, const RunArgs& a, const std::string& photo,
       return write_video(std::move(result.mpi), a.video_options, file.string(), false);
     });
   staging.commit();
+  release_free_memory();  // the next photo's buffers do not come on top of this one's
   progress.note(photo + ": " + std::to_string(planes) + " planes, inpainted by " +
                 result.inpainter + " -> " + destination);
 }

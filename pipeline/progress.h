@@ -3,6 +3,7 @@
 // tell it (`ampi bench pipeline` shows it per stage).
 #pragma once
 #include <chrono>
+#include <cstddef>
 #include <string>
 #include <utility>
 #include <vector>
@@ -18,10 +19,13 @@ double current_rss_mb();
 // what getrusage and `/usr/bin/time -v` report as the process's maximum, so only
 // measuring code calls it.
 bool reset_peak_rss();
-// Hands the heap's free pages back to the system (glibc: malloc_trim). Buffers under
-// malloc's mmap threshold (it grows up to 32 MB) are freed into the heap and kept there;
-// without this, the next stage's large buffers come on top of what the last one freed.
-void release_free_memory();
+// Hands the heap's free pages back to the system (glibc: malloc_trim) when it holds at
+// least `at_least` bytes free. Buffers under malloc's mmap threshold (it grows up to
+// 32 MB) are freed into the heap and kept there, and the next stage's larger buffers
+// would come on top of them. Progress does it after every stage that leaves 64 MB or
+// more free (smaller amounts are kept: giving them back would cost the next stage page
+// faults), `ampi run` after every photo.
+void release_free_memory(size_t at_least = 0);
 
 class Progress {
  public:
@@ -30,8 +34,7 @@ class Progress {
   explicit Progress(bool quiet = false, bool measure_memory = false)
       : quiet_(quiet), measure_memory_(measure_memory) {}
 
-  // Runs body() as the stage `name`, timing it (and measuring its peak memory). Memory
-  // the stage freed is released to the system when it ends.
+  // Runs body() as the stage `name`, timing it (and measuring its peak memory).
   template <class Body>
   auto stage(const std::string& name, Body&& body) -> decltype(body()) {
     if (measure_memory_) reset_peak_rss();
