@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <cstring>
+#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -21,6 +23,45 @@ constexpr int kMaxDepthwiseKernelH = 16;
 constexpr int kGemmTilesPerIm2colTile = 8;
 // Pointwise path: gemm tiles per parallel_for grain, enough to amortise the scheduling.
 constexpr int64_t kPointwiseGrainTiles = 4;
+
+// Outputs (depthwise and pointwise) larger than this many last-level caches go out with
+// streaming stores (DepthwiseRowArgs::stream_out, GemmArgs::stream_c). Outputs that may
+// still be cached when the next layer reads them keep plain stores: streaming a 12 MB
+// output (3x3 s2 over 512x384x64) measured 10% slower than plain stores with a 32 MB L3.
+constexpr size_t kStreamOutputCaches = 1;
+// When the system does not say (no sysfs cache description, e.g. under qemu).
+constexpr size_t kDefaultLastLevelCacheBytes = size_t{32} << 20;
+
+// The size of CPU 0's highest cache level, from sysfs ("32768K"). Not sysconf: glibc
+// reads it from cpuid, which under KVM here says 384 MiB for a 32 MiB L3.
+size_t last_level_cache_bytes() {
+  static const size_t bytes = [] {
+    int best_level = 0;
+    size_t best_bytes = kDefaultLastLevelCacheBytes;
+    for (int index = 0; index < 8; ++index) {
+      const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/";
+      std::ifstream level_file(dir + "level"), size_file(dir + "size");
+      int level = 0;
+      size_t size = 0;
+      std::string unit;
+      if (!(level_file >> level) || !(size_file >> size)) continue;
+      size_file >> unit;
+      const size_t scale = unit == "K" ? 1024 : unit == "M" ? 1024 * 1024 : 1;
+      if (level > best_level && size > 0) best_level = level, best_bytes = size * scale;
+    }
+    return best_bytes;
+  }();
+  return bytes;
+}
+
+// Whether an output of `floats` at `out` with c channels (c floats apart, pixel after
+// pixel) can and should be stored with streaming stores (DepthwiseRowArgs::stream_out,
+// GemmArgs::stream_c).
+bool stream_output(const float* out, int64_t floats, int c) {
+  const bool whole_lines = reinterpret_cast<uintptr_t>(out) % 64 == 0 && c % 16 == 0;
+  const size_t bytes = static_cast<size_t>(floats) * sizeof(float);
+  return whole_lines && bytes > kStreamOutputCaches * last_level_cache_bytes();
+}
 
 [[noreturn]] void fail(const std::string& what) { throw std::runtime_error("conv: " + what); }
 
@@ -186,6 +227,7 @@ void Conv2d::run_pointwise(const float* in, int64_t pixels, float* out, const fl
   base.packed = packed_.get();
   base.c_stride = p_.out_c;
   base.act = p_.act;
+  base.stream_c = stream_output(out, pixels * p_.out_c, p_.out_c);
   const int64_t tiles = (pixels + mr - 1) / mr;
   pool.parallel_for(tiles, kPointwiseGrainTiles, [&](int64_t first, int64_t last) {
     GemmArgs g = base;
@@ -217,6 +259,7 @@ void Conv2d::run_depthwise(const float* in, int in_h, int in_w, float* out, cons
   base.bias = packed_.get() + static_cast<int64_t>(p_.kernel_h) * p_.kernel_w * c;
   base.act = p_.act;
   const int64_t row_floats = static_cast<int64_t>(out_w) * c;
+  base.stream_out = stream_output(out, row_floats * out_h, c);
   pool.parallel_for(out_h, 1, [&](int64_t first, int64_t last) {
     std::array<const float*, kMaxDepthwiseKernelH> rows;
     DepthwiseRowArgs a = base;

@@ -28,6 +28,11 @@ struct GemmArgs {
   int64_t c_stride = 0;
   const float* residual = nullptr;  // nullptr, or laid out like c (same stride)
   ActivationSpec act;
+  // The whole output is larger than the last-level cache (it is evicted before the next
+  // layer reads it back), c and c_stride are 64-byte aligned and n a multiple of 16:
+  // kernels may store whole lines with non-temporal stores, which skip reading each
+  // output line from memory before writing it.
+  bool stream_c = false;
 };
 
 // One output row of a depthwise convolution (channel multiplier 1), NHWC:
@@ -50,6 +55,11 @@ struct DepthwiseRowArgs {
   // none): kernels may prefetch it at the columns they are reading, so the next call
   // finds it in cache instead of waiting for memory.
   const float* prefetch_row = nullptr;
+  // The output is larger than the last-level cache (it is evicted before the
+  // next layer reads it back), out is 64-byte aligned and channels a multiple of 16:
+  // kernels may store whole lines with non-temporal stores, which skip reading each
+  // output line from memory before writing it (a third of a depthwise layer's traffic).
+  bool stream_out = false;
 };
 
 struct KernelTable {

@@ -14,14 +14,19 @@ namespace ampi::neon {
 struct Vector {
   static float32x4_t load(const float* p) { return vld1q_f32(p); }
   static void store(float* p, float32x4_t v) { vst1q_f32(p, v); }
+  // Plain stores: a 16-byte vector is a quarter of a line, too little to stream.
+  static void stream(float* p, float32x4_t v) { vst1q_f32(p, v); }
   static float32x4_t splat(float x) { return vdupq_n_f32(x); }
 };
 
 struct Scalar {
   static float load(const float* p) { return *p; }
   static void store(float* p, float v) { *p = v; }
+  static void stream(float* p, float v) { *p = v; }
   static float splat(float x) { return x; }
 };
+
+inline void finish_streaming() {}
 
 inline float32x4_t plus(float32x4_t a, float32x4_t b) { return vaddq_f32(a, b); }
 inline float32x4_t minus(float32x4_t a, float32x4_t b) { return vsubq_f32(a, b); }

@@ -19,14 +19,21 @@ namespace ampi::avx2 {
 struct Vector {
   static __m256 load(const float* p) { return _mm256_loadu_ps(p); }
   static void store(float* p, __m256 v) { _mm256_storeu_ps(p, v); }
+  // Non-temporal store, 32-byte aligned: written to memory without reading the line
+  // first and without evicting cached data for it.
+  static void stream(float* p, __m256 v) { _mm256_stream_ps(p, v); }
   static __m256 splat(float x) { return _mm256_set1_ps(x); }
 };
 
 struct Scalar {
   static float load(const float* p) { return *p; }
   static void store(float* p, float v) { *p = v; }
+  static void stream(float* p, float v) { *p = v; }
   static float splat(float x) { return x; }
 };
+
+// Orders the streaming stores before the stores that follow (the thread pool's "done").
+inline void finish_streaming() { _mm_sfence(); }
 
 inline __m256 plus(__m256 a, __m256 b) { return _mm256_add_ps(a, b); }
 inline __m256 minus(__m256 a, __m256 b) { return _mm256_sub_ps(a, b); }

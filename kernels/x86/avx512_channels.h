@@ -12,14 +12,22 @@ struct MaskedVector {
   __mmask16 mask;
   __m512 load(const float* p) const { return _mm512_maskz_loadu_ps(mask, p); }
   void store(float* p, __m512 v) const { _mm512_mask_storeu_ps(p, mask, v); }
+  // A part of a line: no streaming store for it.
+  void stream(float* p, __m512 v) const { store(p, v); }
   __m512 splat(float x) const { return _mm512_set1_ps(x); }
 };
 
 struct FullVector {
   __m512 load(const float* p) const { return _mm512_loadu_ps(p); }
   void store(float* p, __m512 v) const { _mm512_storeu_ps(p, v); }
+  // Non-temporal store of one whole, 64-byte-aligned cache line: written to memory
+  // without reading the line first and without evicting cached data for it.
+  void stream(float* p, __m512 v) const { _mm512_stream_ps(p, v); }
   __m512 splat(float x) const { return _mm512_set1_ps(x); }
 };
+
+// Orders the streaming stores before the stores that follow (the thread pool's "done").
+inline void finish_streaming() { _mm_sfence(); }
 
 // The arithmetic lane-generic kernel bodies (kernels/*_lanes.inl) are written with.
 inline __m512 plus(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }

@@ -2,6 +2,8 @@
 // against the direct reference.
 #include "test_conv_util.h"
 
+#include "engine/tensor.h"
+
 using namespace ampi;
 using namespace ampi::test;
 
@@ -73,4 +75,75 @@ TEST_CASE("depthwise conv matches the reference for other kernel shapes") {
   wide.p.stride_h = 2;
   wide.p.dilation_h = 2;
   check_all_isas(wide, pool);
+}
+
+namespace {
+
+// Output rows [0, out_h) of a depthwise case through one table's row kernel, called
+// directly (Conv2d streams only outputs larger than the last-level cache), into a
+// 64-byte-aligned buffer as DepthwiseRowArgs::stream_out requires.
+std::vector<float> run_rows(const ConvCase& c, const ConvData& d, const KernelTable& k, bool stream_out) {
+  const ConvParams& p = c.p;
+  const int channels = p.in_c, taps = p.kernel_h * p.kernel_w;
+  const int out_h = p.out_h(c.in_h), out_w = p.out_w(c.in_w);
+  std::vector<float> weights(static_cast<size_t>(taps) * channels);  // [tap][c] from OHWI [c][tap]
+  for (int ch = 0; ch < channels; ++ch)
+    for (int t = 0; t < taps; ++t)
+      weights[static_cast<size_t>(t) * channels + ch] = d.weights[static_cast<size_t>(ch) * taps + t];
+  Tensor out = Tensor::empty({out_h, out_w, channels});
+  std::fill(out.f32(), out.f32() + out.numel(), NAN);  // an unwritten value cannot pass
+  DepthwiseRowArgs a;
+  a.in_w = c.in_w;
+  a.channels = channels;
+  a.kernel_h = p.kernel_h;
+  a.kernel_w = p.kernel_w;
+  a.stride_w = p.stride_w;
+  a.pad_left = p.pad_left;
+  a.out_w = out_w;
+  // Columns whose taps all fall inside the row (Conv2d's interior_columns, dilation 1).
+  a.interior_begin = std::min(out_w, (p.pad_left + p.stride_w - 1) / p.stride_w);
+  a.interior_end =
+      std::max(a.interior_begin, std::min(out_w, (c.in_w - p.kernel_w + p.pad_left) / p.stride_w + 1));
+  a.weights = weights.data();
+  a.bias = d.bias.data();
+  a.act = p.act;
+  a.stream_out = stream_out;
+  std::vector<const float*> rows(p.kernel_h);
+  a.in_rows = rows.data();
+  const int64_t row_floats = static_cast<int64_t>(out_w) * channels;
+  for (int y = 0; y < out_h; ++y) {
+    for (int ky = 0; ky < p.kernel_h; ++ky) {
+      const int iy = y * p.stride_h - p.pad_top + ky;
+      const bool inside = iy >= 0 && iy < c.in_h;
+      rows[ky] = inside ? d.in.data() + static_cast<int64_t>(iy) * c.in_w * channels : nullptr;
+    }
+    a.out = out.f32() + y * row_floats;
+    a.residual = d.residual.empty() ? nullptr : d.residual.data() + y * row_floats;
+    k.depthwise_row(a);
+  }
+  return std::vector<float>(out.f32(), out.f32() + out.numel());
+}
+
+}  // namespace
+
+TEST_CASE("depthwise rows with streaming stores match plain stores and the reference") {
+  uint32_t seed = 7000;
+  for (int kernel : {3, 5})
+    for (int stride : {1, 2})
+      for (int channels : {16, 48})
+        for (bool residual : {false, true}) {
+          ConvCase c = depthwise(channels, kernel, stride, 1, same_padding(kernel, 1), 5, 27, seed++);
+          c.p.act = {residual ? Activation::ReLU : Activation::HardSwish};
+          c.residual = residual;
+          const ConvData d(c);
+          const Expected e = expected_output(c, d);
+          for (Isa isa : runnable_isas()) {
+            INFO(describe(c) << ", isa " << isa_name(isa));
+            const std::vector<float> streamed = run_rows(c, d, kernels_for(isa), true);
+            REQUIRE(streamed == run_rows(c, d, kernels_for(isa), false));
+            const float err = max_abs_diff(e.out.data(), streamed.data(), streamed.size());
+            INFO("max error " << err << ", scale " << e.scale);
+            REQUIRE(err <= kRelativeTolerance * e.scale);
+          }
+        }
 }

@@ -2,6 +2,8 @@
 // direct reference.
 #include "test_conv_util.h"
 
+#include "engine/tensor.h"
+
 using namespace ampi;
 using namespace ampi::test;
 
@@ -43,4 +45,56 @@ TEST_CASE("pointwise conv matches the reference for pixel counts around every ro
 TEST_CASE("pointwise conv with long reductions stays within tolerance") {
   ThreadPool pool(2);
   check_all_isas(pointwise(sweep<int>({576}, {160}).front(), 40, 3, 5, 3000), pool);
+}
+
+namespace {
+
+// A 1x1 case through one table's gemm tile, called directly (Conv2d streams only outputs
+// larger than the last-level cache), into a 64-byte-aligned output as
+// GemmArgs::stream_c requires.
+std::vector<float> run_gemm_tiles(const ConvCase& c, const ConvData& d, const KernelTable& k,
+                                  bool stream_c) {
+  const int n = c.p.out_c, kdim = c.p.in_c, pixels = c.in_h * c.in_w;
+  std::vector<float> packed(static_cast<size_t>(gemm_packed_size(n, kdim, k.gemm_nr)));
+  pack_gemm_weights(d.weights.data(), d.bias.data(), n, kdim, k.gemm_nr, packed.data());
+  Tensor out = Tensor::empty({pixels, n});
+  std::fill(out.f32(), out.f32() + out.numel(), NAN);  // an unwritten value cannot pass
+  GemmArgs g;
+  g.n = n;
+  g.k = kdim;
+  g.a_stride = kdim;
+  g.packed = packed.data();
+  g.c_stride = n;
+  g.act = c.p.act;
+  g.stream_c = stream_c;
+  for (int row = 0; row < pixels; row += k.gemm_mr) {
+    g.m = std::min(k.gemm_mr, pixels - row);
+    g.a = d.in.data() + static_cast<int64_t>(row) * kdim;
+    g.c = out.f32() + static_cast<int64_t>(row) * n;
+    g.residual = d.residual.empty() ? nullptr : d.residual.data() + static_cast<int64_t>(row) * n;
+    k.gemm(g);
+  }
+  return std::vector<float>(out.f32(), out.f32() + out.numel());
+}
+
+}  // namespace
+
+TEST_CASE("gemm tiles with streaming stores match plain stores and the reference") {
+  uint32_t seed = 3000;
+  for (int out_c : {16, 32, 48, 64})
+    for (bool residual : {false, true}) {
+      ConvCase c = pointwise(24, out_c, 5, 7, seed++);  // 35 pixels: whole and partial row tiles
+      c.p.act = {residual ? Activation::ReLU : Activation::HardSwish};
+      c.residual = residual;
+      const ConvData d(c);
+      const Expected e = expected_output(c, d);
+      for (Isa isa : runnable_isas()) {
+        INFO(describe(c) << ", isa " << isa_name(isa));
+        const std::vector<float> streamed = run_gemm_tiles(c, d, kernels_for(isa), true);
+        REQUIRE(streamed == run_gemm_tiles(c, d, kernels_for(isa), false));
+        const float err = max_abs_diff(e.out.data(), streamed.data(), streamed.size());
+        INFO("max error " << err << ", scale " << e.scale);
+        REQUIRE(err <= kRelativeTolerance * e.scale);
+      }
+    }
 }
