@@ -237,6 +237,10 @@ void Conv2d::run_pointwise(const float* in, int64_t pixels, float* out, const fl
       g.a = in + row * p_.in_c;
       g.c = out + row * p_.out_c;
       g.residual = residual ? residual + row * p_.out_c : nullptr;
+      // The next tile's rows follow this one's in the input.
+      const int64_t next_rows = std::min<int64_t>(mr, std::max<int64_t>(0, pixels - row - mr));
+      g.prefetch_a = next_rows > 0 ? g.a + static_cast<int64_t>(mr) * p_.in_c : nullptr;
+      g.prefetch_floats = next_rows * p_.in_c;
       k_->gemm(g);
     }
   });

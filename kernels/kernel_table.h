@@ -33,6 +33,11 @@ struct GemmArgs {
   // kernels may store whole lines with non-temporal stores, which skip reading each
   // output line from memory before writing it.
   bool stream_c = false;
+  // The next call's A, floats [prefetch_a, prefetch_a + prefetch_floats) (nullptr: none):
+  // kernels may prefetch it while this tile computes, so the next call does not wait for
+  // memory.
+  const float* prefetch_a = nullptr;
+  int64_t prefetch_floats = 0;
 };
 
 // One output row of a depthwise convolution (channel multiplier 1), NHWC:
