@@ -195,8 +195,11 @@ def cpu_model() -> str:
 
 
 def git_commit() -> str:
+    """HEAD, and whether tracked files differed from it (what the build then held)."""
     proc = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True, cwd=REPO)
-    return proc.stdout.strip() or "unknown"
+    dirty = subprocess.run(["git", "status", "--porcelain", "--untracked-files=no"],
+                           capture_output=True, text=True, cwd=REPO).stdout.strip()
+    return (proc.stdout.strip() or "unknown") + (" (tracked files modified in the tree)" if dirty else "")
 
 
 def versions(cases) -> dict:
@@ -314,11 +317,32 @@ def wrap_note(args) -> str:
             "which waits for a quiet machine (one benchmark at a time, background jobs paused)")
 
 
-def save_raw(args, cases):
+# The settings a report states, kept with the raw timings so --report-from can re-make it.
+REPORT_SETTINGS = ("models", "sizes", "threads", "warmup", "wrap", "max_foreign", "retries", "wait_quiet", "commit")
+
+
+def save_raw(args, cases, seconds: float):
     """Every timed run of every engine, for a closer look than the medians."""
     raw = args.work / "cases.json"
-    raw.write_text(json.dumps(cases, indent=1))
+    settings = {k: getattr(args, k) for k in REPORT_SETTINGS}
+    raw.write_text(json.dumps({"settings": settings, "seconds": seconds, "cases": cases}, indent=1))
     print(f"run_peers.py: raw timings in {raw}", file=sys.stderr)
+
+
+def load_raw(args, path: Path):
+    """The cases and duration of a run saved by save_raw; args takes that run's settings."""
+    try:
+        raw = json.loads(path.read_text())
+        for k in REPORT_SETTINGS:
+            setattr(args, k, raw["settings"][k])
+        cases = raw["cases"]
+    except (OSError, ValueError, KeyError, TypeError) as e:
+        fail(f"{path}: not the raw timings of a run ({e})")
+    for case in cases:  # JSON turned the thread counts into strings
+        case["engines"] = {e: {int(t): r for t, r in by.items()} for e, by in case["engines"].items()}
+        case["diff"] = {p: {int(t): d for t, d in by.items()} for p, by in case["diff"].items()}
+        case["range"] = {int(t): tuple(r) for t, r in case["range"].items()}
+    return cases, raw["seconds"]
 
 
 def write_results(args, cases, seconds: float):
@@ -334,7 +358,7 @@ def write_results(args, cases, seconds: float):
     lines = [
         "# Peer benchmark: ampi's depth network beside ONNX Runtime, OpenCV DNN and PyTorch", "",
         "Made by `bash bench/peers/run.sh` (bench/peers/README.md) in one run of "
-        f"{seconds / 60:.1f} minutes (wall clock, waits included) at commit {git_commit()}, with "
+        f"{seconds / 60:.1f} minutes (wall clock, waits included) at commit {args.commit}, with "
         f"`--models {args.models} --sizes {args.sizes} --threads {','.join(map(str, args.threads))} "
         f"--warmup {args.warmup}`{wrap_note(args)}; rerun it to refresh this file.", "",
         f"- Machine: {cpu_model()}, {os.cpu_count()} cores; ampi's kernels: {v['isa']}.",
@@ -383,6 +407,8 @@ def main(argv=None):
     p.add_argument("--retries", type=int, default=5, help="re-runs of an engine on a busy machine")
     p.add_argument("--wait-quiet", type=float, default=30,
                    help="seconds each engine waits at most for a quiet half-second before it starts")
+    p.add_argument("--report-from", type=Path, help="re-make the report from a run's raw timings "
+                   "(WORK/cases.json) instead of measuring")
     p.add_argument("--wrap", type=shlex.split, default=[],
                    help="a command prefixed to each timed engine process, e.g. '/tmp/quiet.sh' "
                         "(waits for a lock and pauses background jobs while the engine runs)")
@@ -394,7 +420,10 @@ def main(argv=None):
     if not args.photo.is_file():
         fail(f"{args.photo}: no such photo")
 
-    start = time.time()
+    if args.report_from:
+        write_results(args, *load_raw(args, args.report_from))
+        return
+    start, args.commit = time.time(), git_commit()
     cases = []
     for model in args.models.split(","):
         weights = REPO / "weights" / f"depth_{model}.ampw"
@@ -413,7 +442,7 @@ def main(argv=None):
         if worst > args.tolerance:
             fail(f"a peer's output differs from ampi's by {worst:.2e} of its range (tolerance {args.tolerance:.0e})")
         return
-    save_raw(args, cases)
+    save_raw(args, cases, time.time() - start)
     write_results(args, cases, time.time() - start)
 
 
