@@ -32,7 +32,7 @@ namespace {
 
 const char kUsage[] =
     "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
-    "                           [--network-inpainting] [--working-size N] [--out FILE]\n"
+    "                           [--inpainter network|push-pull] [--working-size N] [--out FILE]\n"
     "\n"
     "Times every stage of `ampi run` (decode, depth, slicing, assembly, inpainting, MPI\n"
     "write, render + encode of the video) on PHOTO resized to 1024x768 and to 3840x2160,\n"
@@ -44,7 +44,7 @@ const char kUsage[] =
     "  --runs N       runs per size (default 3)\n"
     "  --threads N    worker threads (default 2)\n"
     "  --frames N     video frames rendered and encoded per run (default 30)\n"
-    "  --network-inpainting  the inpainting network instead of push-pull\n"
+    "  --inpainter NAME      network (default, as ampi run) or push-pull\n"
     "  --working-size N      the depth network's long side (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
@@ -199,7 +199,11 @@ int pipeline_benchmark(int argc, char** argv) {
   p.option("--threads", &threads, 1, 256);
   p.option("--frames", &frames, 1, 10000);
   p.option("--out", &out);
-  p.flag("--network-inpainting", &options.network_inpainting);
+  p.option("--inpainter", [&](const std::string& v) {
+    if (v != "push-pull" && v != "network")
+      throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
+    options.network_inpainting = v == "network";
+  });
   p.option("--working-size", &options.working_size, kMinPhotoSide, 16384);
   if (!p.parse(argc, argv)) return 0;
   set_default_threads(threads);

@@ -297,7 +297,7 @@ const char kSlicingUsage[] =
     "  --working-size N        long side the network runs at (default: the weight file's)\n"
     "  --depth-dir D           depth maps instead of the network: the one file D/sub/name.* for\n"
     "                          DIR/sub/name.jpg, any format ampi run --depth reads, larger = nearer\n"
-    "  --inpainter I           push-pull (default, as ampi run) or network (weights/inpaint.ampw)\n"
+    "  --inpainter I           push-pull (default) or network (weights/inpaint.ampw; ampi run's default)\n"
     "  --limit N               only the first N photos\n"
     "  --threads N             worker threads (default: all hardware threads)\n";
 

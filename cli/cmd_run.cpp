@@ -52,7 +52,7 @@ const char kUsage[] =
     "  --max-planes N          at most N planes (default 8)\n"
     "  --uniform               equal disparity intervals (the paper's baseline)\n"
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
-    "  --inpainter NAME        push-pull (default) or network: what fills occluded margins\n"
+    "  --inpainter NAME        network (default) or push-pull (faster): what fills occluded margins\n"
     "  --inpaint-weights FILE  inpainting network weight file (implies --inpainter network)\n"
     "  --fov DEG               assumed horizontal field of view (default 60)\n"
     "  --trajectory NAME       circle, swing, zoom-in or dolly-zoom (default circle)\n"

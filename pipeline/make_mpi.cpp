@@ -61,7 +61,7 @@ cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, cv::Size photo_size, con
 
 LayerFiller& MpiMaker::filler() {
   if (filler_) return *filler_;
-  if (!options_.network_inpainting && options_.inpaint_weights.empty()) {
+  if (!options_.network_inpainting && options_.inpaint_weights.empty()) {  // weights imply the network
     filler_ = push_pull_filler();
     inpainter_ = "push-pull";
   } else {
