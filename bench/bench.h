@@ -1,8 +1,16 @@
 // Benchmarks behind `ampi bench WHAT`. Each takes its own argv (argv[0] = WHAT),
 // prints a table and writes it to bench/RESULTS-WHAT.md.
 #pragma once
+#include <algorithm>
+#include <vector>
 
 namespace ampi::bench {
+
+// The median of timed runs (the upper one of an even count); 0 for none.
+inline double median(std::vector<double> v) {
+  std::sort(v.begin(), v.end());
+  return v.empty() ? 0 : v[v.size() / 2];
+}
 
 // ampi bench kernels [--threads N] [--runs N] [--clock wall|cpu] [--out FILE]: convolution
 // kernels of every runnable ISA against the machine's FMA peak and memory bandwidth

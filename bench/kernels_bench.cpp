@@ -282,11 +282,6 @@ struct Scaling {
   double ratio() const { return ms1 / ms2; }
 };
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
-}
-
 Scaling network_scaling(const std::string& weights, int runs) {
   DepthNet net = DepthNet::load(weights);
   Tensor rgb = Tensor::empty({kNetworkH, kNetworkW, 3});

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <vector>
 
+#include "bench/bench.h"
 #include "engine/tensor.h"
 
 #if defined(AMPI_ARCH_X86)
@@ -90,11 +91,6 @@ FmaLoop fma_loop_for(Isa isa) {
 #endif
     default: return {scalar_fma_loop, 1};
   }
-}
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v[v.size() / 2];
 }
 
 // Keeps the loops' results observable.

@@ -48,11 +48,6 @@ const char kUsage[] =
     "  --working-size N      the depth network's long side (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  return v.empty() ? 0 : v[v.size() / 2];
-}
-
 struct SizeResult {
   cv::Size size;
   std::vector<std::string> stages;             // in pipeline order

@@ -31,7 +31,6 @@ double status_mb(const char* name) {
 }  // namespace
 
 double peak_rss_mb() { return status_mb("VmHWM"); }
-double current_rss_mb() { return status_mb("VmRSS"); }
 
 bool reset_peak_rss() {
   std::FILE* f = std::fopen("/proc/self/clear_refs", "w");

@@ -10,10 +10,9 @@
 
 namespace ampi {
 
-// The process's resident memory in MB: its peak since the last reset_peak_rss() (or
-// since it started), and now. 0 where /proc cannot tell.
+// The process's peak resident memory in MB since the last reset_peak_rss() (or since it
+// started); 0 where /proc cannot tell.
 double peak_rss_mb();
-double current_rss_mb();
 // Starts a new peak window (Linux: /proc/self/clear_refs); false where unsupported,
 // and the peak then stays the one since the process started. The reset also lowers
 // what getrusage and `/usr/bin/time -v` report as the process's maximum, so only

@@ -135,15 +135,6 @@ TEST_CASE("depthwise rows with streaming stores match plain stores and the refer
           ConvCase c = depthwise(channels, kernel, stride, 1, same_padding(kernel, 1), 5, 27, seed++);
           c.p.act = {residual ? Activation::ReLU : Activation::HardSwish};
           c.residual = residual;
-          const ConvData d(c);
-          const Expected e = expected_output(c, d);
-          for (Isa isa : runnable_isas()) {
-            INFO(describe(c) << ", isa " << isa_name(isa));
-            const std::vector<float> streamed = run_rows(c, d, kernels_for(isa), true);
-            REQUIRE(streamed == run_rows(c, d, kernels_for(isa), false));
-            const float err = max_abs_diff(e.out.data(), streamed.data(), streamed.size());
-            INFO("max error " << err << ", scale " << e.scale);
-            REQUIRE(err <= kRelativeTolerance * e.scale);
-          }
+          check_streaming_all_isas(c, run_rows);
         }
 }

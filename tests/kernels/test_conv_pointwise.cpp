@@ -86,15 +86,6 @@ TEST_CASE("gemm tiles with streaming stores match plain stores and the reference
       ConvCase c = pointwise(24, out_c, 5, 7, seed++);  // 35 pixels: whole and partial row tiles
       c.p.act = {residual ? Activation::ReLU : Activation::HardSwish};
       c.residual = residual;
-      const ConvData d(c);
-      const Expected e = expected_output(c, d);
-      for (Isa isa : runnable_isas()) {
-        INFO(describe(c) << ", isa " << isa_name(isa));
-        const std::vector<float> streamed = run_gemm_tiles(c, d, kernels_for(isa), true);
-        REQUIRE(streamed == run_gemm_tiles(c, d, kernels_for(isa), false));
-        const float err = max_abs_diff(e.out.data(), streamed.data(), streamed.size());
-        INFO("max error " << err << ", scale " << e.scale);
-        REQUIRE(err <= kRelativeTolerance * e.scale);
-      }
+      check_streaming_all_isas(c, run_gemm_tiles);
     }
 }

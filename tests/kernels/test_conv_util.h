@@ -133,4 +133,20 @@ inline void check_all_isas(const ConvCase& c, ThreadPool& pool) {
   }
 }
 
+// On every runnable table: run(case, data, table, stream) with streaming stores equals it
+// with plain stores bit for bit, and matches the reference.
+template <class Run>
+void check_streaming_all_isas(const ConvCase& c, Run run) {
+  const ConvData d(c);
+  const Expected e = expected_output(c, d);
+  for (Isa isa : runnable_isas()) {
+    INFO(describe(c) << ", isa " << isa_name(isa));
+    const std::vector<float> streamed = run(c, d, kernels_for(isa), true);
+    REQUIRE(streamed == run(c, d, kernels_for(isa), false));
+    const float err = max_abs_diff(e.out.data(), streamed.data(), streamed.size());
+    INFO("max error " << err << ", scale " << e.scale);
+    REQUIRE(err <= kRelativeTolerance * e.scale);
+  }
+}
+
 }  // namespace ampi::test
