@@ -6,21 +6,11 @@
 #include <stdexcept>
 #include <string>
 
+#include "slicing/bilateral.h"
 #include "slicing/level_stats.h"
 
 namespace ampi {
 namespace {
-
-void check_disparity(const cv::Mat& disparity) {
-  if (disparity.empty()) throw std::invalid_argument("slicing: the disparity map is empty");
-  if (disparity.type() != CV_32FC1)
-    throw std::invalid_argument("slicing: the disparity map must be CV_32FC1 (one float channel)");
-  // A finite sum proves every value finite (a NaN or an infinity would spread to it) in
-  // one fast pass; only a sum that is not (extreme values overflow OpenCV's partial
-  // sums) needs checkRange's slower look.
-  if (!std::isfinite(cv::sum(disparity)[0]) && !cv::checkRange(disparity, true))
-    throw std::invalid_argument("slicing: the disparity map contains NaN or infinite values");
-}
 
 void check_params(const SlicingParams& p) {
   auto require = [](bool ok, const char* what) {
@@ -41,18 +31,12 @@ double mass(const std::vector<double>& prefix, int lo, int end) { return prefix[
 }  // namespace
 
 cv::Mat normalize_disparity_float(const cv::Mat& disparity) {
-  check_disparity(disparity);
-  double lo = 0, hi = 0;
-  cv::minMaxLoc(disparity, &lo, &hi);
-  cv::Mat out = cv::Mat::zeros(disparity.size(), CV_32FC1);
-  if (!(hi > lo)) return out;
-  // Offset first, then scale and clamp: the extremes land exactly on 0 and 255. Double
-  // precision keeps the difference of any two finite floats finite.
-  const double top = kDisparityLevels - 1, scale = top / (hi - lo);
+  const Normalization normalize = normalization_of(disparity);
+  cv::Mat out(disparity.size(), CV_32FC1);
   for (int y = 0; y < disparity.rows; ++y) {
     const float* in = disparity.ptr<float>(y);
     float* v = out.ptr<float>(y);
-    for (int x = 0; x < disparity.cols; ++x) v[x] = static_cast<float>(std::min((in[x] - lo) * scale, top));
+    for (int x = 0; x < disparity.cols; ++x) v[x] = normalize(in[x]);
   }
   return out;
 }
@@ -65,9 +49,9 @@ cv::Mat normalize_disparity(const cv::Mat& disparity) {
 
 std::vector<double> slicing_histogram(const cv::Mat& normalized, const SlicingParams& p) {
   CV_Assert(normalized.type() == CV_8UC1 && !normalized.empty());
-  cv::Mat filtered, edges, band;
-  cv::bilateralFilter(normalized, filtered, p.bilateral_diameter, p.bilateral_sigma_color,
-                      p.bilateral_sigma_space);
+  const cv::Mat filtered = bilateral_filter_levels(
+      normalized, {p.bilateral_diameter, p.bilateral_sigma_color, p.bilateral_sigma_space});
+  cv::Mat edges, band;
   cv::Canny(filtered, edges, p.canny_low, p.canny_high);
   // The paper's "erosion" of the borders: eroding the map's non-edge region is dilating
   // the edge band. Leaving the band out deepens the valleys between depth clusters.
@@ -156,13 +140,11 @@ int plane_of_level(const std::vector<Plane>& planes, int level) {
 
 std::vector<Plane> slice_adaptive(const cv::Mat& disparity, const SlicingParams& p) {
   check_params(p);
-  const cv::Mat normalized_float = normalize_disparity_float(disparity);
-  cv::Mat normalized;
-  normalized_float.convertTo(normalized, CV_8U);
-  const std::vector<double> h = slicing_histogram(normalized, p);
+  const NormalizedLevels normalized = normalize_with_stats(disparity);
+  const LevelStats& stats = normalized.stats;
+  const std::vector<double> h = slicing_histogram(normalized.levels, p);
   const std::vector<double> t = transition_index(h, p.eps);
   const std::vector<int> selected = select_transitions(t, h, p.xi, p.threshold, p.max_planes - 1);
-  const LevelStats stats = level_stats(normalized, normalized_float);
   const std::vector<int> b = plane_boundaries(selected, stats.count);
   std::vector<Plane> planes;
   for (size_t j = 0; j + 1 < b.size(); ++j) planes.push_back(plane_for_interval(stats, b[j], b[j + 1], p.range));

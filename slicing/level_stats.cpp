@@ -1,8 +1,57 @@
 #include "slicing/level_stats.h"
 
+#include <cmath>
+#include <stdexcept>
+
 #include "slicing/adaptive.h"
 
 namespace ampi {
+
+Normalization normalization_of(const cv::Mat& disparity) {
+  if (disparity.empty()) throw std::invalid_argument("slicing: the disparity map is empty");
+  if (disparity.type() != CV_32FC1)
+    throw std::invalid_argument("slicing: the disparity map must be CV_32FC1 (one float channel)");
+  // A finite sum proves every value finite (a NaN or an infinity would spread to it) in
+  // one fast pass; only a sum that is not (extreme values overflow OpenCV's partial
+  // sums) needs checkRange's slower look.
+  if (!std::isfinite(cv::sum(disparity)[0]) && !cv::checkRange(disparity, true))
+    throw std::invalid_argument("slicing: the disparity map contains NaN or infinite values");
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(disparity, &lo, &hi);
+  return {lo, hi > lo ? (kDisparityLevels - 1) / (hi - lo) : 0.0};
+}
+
+NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
+  const Normalization normalize = normalization_of(disparity);
+  // Four tables, pixel x counted in table x % 4, as in level_histogram: neighbours,
+  // which mostly share a level, then update different counters instead of waiting.
+  constexpr int kTables = 4;
+  long long count[kTables][kDisparityLevels] = {};
+  double sum[kTables][kDisparityLevels] = {};
+  NormalizedLevels out{cv::Mat(disparity.size(), CV_8UC1), {}};
+  auto add = [&](int table, float d, uchar& level) {
+    const float value = normalize(d);
+    const int l = cvRound(value);  // as convertTo: nearest, ties to even
+    level = static_cast<uchar>(l);
+    ++count[table][l];
+    sum[table][l] += value;
+  };
+  for (int y = 0; y < disparity.rows; ++y) {
+    const float* in = disparity.ptr<float>(y);
+    uchar* level = out.levels.ptr<uchar>(y);
+    int x = 0;
+    for (; x + kTables <= disparity.cols; x += kTables)
+      for (int k = 0; k < kTables; ++k) add(k, in[x + k], level[x + k]);
+    for (; x < disparity.cols; ++x) add(0, in[x], level[x]);
+  }
+  out.stats = {std::vector<long long>(kDisparityLevels, 0), std::vector<double>(kDisparityLevels, 0.0)};
+  for (int k = 0; k < kTables; ++k)
+    for (int l = 0; l < kDisparityLevels; ++l) {
+      out.stats.count[l] += count[k][l];
+      out.stats.sum[l] += sum[k][l];
+    }
+  return out;
+}
 
 LevelStats level_stats(const cv::Mat& normalized, const cv::Mat& normalized_float) {
   CV_Assert(normalized.type() == CV_8UC1 && normalized_float.type() == CV_32FC1 &&

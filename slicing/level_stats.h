@@ -2,10 +2,12 @@
 // pass: how many pixels round to each level and the sum of their unrounded values. Plane
 // statistics (pixel count, mean disparity) then cost 256 additions instead of a pass.
 #pragma once
+#include <algorithm>
 #include <opencv2/core.hpp>
 #include <vector>
 
 #include "mpi/mpi.h"
+#include "slicing/adaptive.h"
 
 namespace ampi {
 
@@ -14,8 +16,29 @@ struct LevelStats {
   std::vector<double> sum;       // of the unrounded normalised values
 };
 
-// normalized: CV_8UC1 levels; normalized_float: the same map before rounding.
+// Min-max normalisation of a disparity map onto [0, 255]. Offset first, then scale and
+// clamp, in double precision (the difference of any two finite floats is finite there):
+// the extremes land exactly on 0 and 255.
+struct Normalization {
+  double lo = 0, scale = 0;  // scale 0: a constant map, all zeros
+  float operator()(float d) const {
+    return static_cast<float>(std::min((d - lo) * scale, double(kDisparityLevels - 1)));
+  }
+};
+// Checks the map (std::invalid_argument if it is empty, not CV_32FC1, or holds NaN or
+// infinite values) and finds its range.
+Normalization normalization_of(const cv::Mat& disparity);
+
+// The reference: from the levels (CV_8UC1) and the same map before rounding.
 LevelStats level_stats(const cv::Mat& normalized, const cv::Mat& normalized_float);
+
+// The disparity map normalised and rounded to levels (CV_8UC1, as normalize_disparity)
+// and their LevelStats, in one pass over the map without the unrounded copy.
+struct NormalizedLevels {
+  cv::Mat levels;
+  LevelStats stats;
+};
+NormalizedLevels normalize_with_stats(const cv::Mat& disparity);
 
 // Histogram of `levels` (CV_8UC1) over the pixels where `excluded` (CV_8UC1, or empty
 // for none) is 0, normalised to sum 1 (all zeros when no pixel counts). The reference

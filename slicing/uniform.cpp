@@ -9,10 +9,7 @@ namespace ampi {
 std::vector<Plane> slice_uniform(const cv::Mat& disparity, int planes, const DepthRange& range) {
   if (planes < 1 || planes > kDisparityLevels - 1)
     throw std::invalid_argument("uniform slicing: the plane count must be in 1..255");
-  const cv::Mat normalized_float = normalize_disparity_float(disparity);
-  cv::Mat normalized;
-  normalized_float.convertTo(normalized, CV_8U);
-  const LevelStats stats = level_stats(normalized, normalized_float);
+  const LevelStats stats = normalize_with_stats(disparity).stats;
   std::vector<Plane> out;
   for (int j = 0; j < planes; ++j) {
     // Interval j covers the levels [256 j / N, 256 (j + 1) / N); the last ends at 255,

@@ -51,3 +51,24 @@ TEST_CASE("level_histogram equals its reference, with and without excluded pixel
     }
   }
 }
+
+TEST_CASE("normalize_with_stats equals the float map's levels and their reference stats") {
+  std::mt19937 rng(11);
+  std::normal_distribution<float> value(0.0f, 40.0f);
+  for (int w : {1, 3, 4, 5, 130, 257}) {
+    cv::Mat disparity(17, w, CV_32FC1);
+    for (int y = 0; y < disparity.rows; ++y)
+      for (int x = 0; x < w; ++x)  // runs of equal values, as flat regions have
+        disparity.at<float>(y, x) = x % 5 == 0 ? value(rng) : disparity.at<float>(y, x - 1);
+    const NormalizedLevels got = normalize_with_stats(disparity);
+    const cv::Mat levels = normalize_disparity(disparity);
+    const LevelStats expected = level_stats(levels, normalize_disparity_float(disparity));
+    INFO("width " << w);
+    REQUIRE(cv::norm(got.levels, levels, cv::NORM_INF) == 0);
+    REQUIRE(got.stats.count == expected.count);
+    for (int l = 0; l < kDisparityLevels; ++l)  // the same values, summed in another order
+      REQUIRE(got.stats.sum[l] == Approx(expected.sum[l]).epsilon(1e-12).margin(1e-9));
+  }
+  CHECK_THROWS_AS(normalize_with_stats(cv::Mat()), std::invalid_argument);
+  CHECK_THROWS_AS(normalize_with_stats(cv::Mat(2, 2, CV_8UC1)), std::invalid_argument);
+}

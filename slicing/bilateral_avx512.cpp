@@ -1,0 +1,73 @@
+// AVX-512 variant of the bilateral row (see bilateral_kernels.h): 16 pixels at a time,
+// the row's tail under a lane mask.
+#include <cstdint>
+
+#include "slicing/bilateral_kernels.h"
+
+#if defined(__x86_64__)
+#include <immintrin.h>
+
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512vl,fma"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx512f,avx512bw,avx512vl,fma")
+// GCC 12 warns falsely inside its own masked-load intrinsics (as in cmake/isa.cmake).
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+
+namespace ampi::slicing::avx512 {
+namespace {
+
+// 2^y for y <= 0, as in the AVX2 variant; scalef applies 2^n.
+inline __m512 exp2_nonpositive(__m512 y) {
+  y = _mm512_max_ps(y, _mm512_set1_ps(-126.0f));
+  const __m512 n = _mm512_roundscale_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  const __m512 f = _mm512_sub_ps(y, n);
+  __m512 p = _mm512_set1_ps(1.540353039e-4f);
+  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(1.333355815e-3f));
+  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(9.618129108e-3f));
+  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(5.550410866e-2f));
+  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(2.402265070e-1f));
+  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(6.931471806e-1f));
+  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(1.0f));
+  return _mm512_scalef_ps(p, n);
+}
+
+inline __m512 load16(const uint8_t* p, __mmask16 lanes) {
+  return _mm512_cvtepi32_ps(_mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(lanes, p)));
+}
+
+// Pixels [x, x + 16) of the row, those outside `lanes` neither read nor written.
+inline void filter16(const uint8_t* c, const BilateralTaps& taps, __mmask16 lanes, uint8_t* out) {
+  const __m512 v0 = load16(c, lanes), coeff = _mm512_set1_ps(taps.color_log2_coeff);
+  __m512 sum = _mm512_setzero_ps(), wsum = _mm512_setzero_ps();
+  for (int k = 0; k < taps.count; ++k) {
+    const __m512 v = load16(c + taps.offset[k], lanes);
+    const __m512 d = _mm512_sub_ps(v, v0);
+    const __m512 w = exp2_nonpositive(
+        _mm512_fmadd_ps(_mm512_mul_ps(d, d), coeff, _mm512_set1_ps(taps.log2_space_weight[k])));
+    sum = _mm512_fmadd_ps(w, v, sum);
+    wsum = _mm512_add_ps(wsum, w);
+  }
+  // Masked-off lanes hold 0 / w: defined, never stored.
+  const __m512i q = _mm512_cvtps_epi32(_mm512_div_ps(sum, wsum));  // nearest, MXCSR default
+  _mm_mask_storeu_epi8(out, lanes, _mm512_cvtusepi32_epi8(q));
+}
+
+}  // namespace
+
+void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
+  int x = 0;
+  for (; x + 16 <= width; x += 16) filter16(center + x, taps, 0xFFFF, out + x);
+  if (x < width) filter16(center + x, taps, static_cast<__mmask16>((1u << (width - x)) - 1), out + x);
+}
+
+}  // namespace ampi::slicing::avx512
+
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
+#endif  // __x86_64__

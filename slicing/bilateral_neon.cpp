@@ -1,0 +1,80 @@
+// NEON variant of the bilateral row (see bilateral_kernels.h): 8 pixels at a time as two
+// 4-float halves, every tap weight one power of two computed in registers.
+#include <cstdint>
+#include <cstring>
+
+#include "slicing/bilateral_kernels.h"
+
+#if defined(__aarch64__)
+#include <arm_neon.h>
+
+namespace ampi::slicing::neon {
+namespace {
+
+// 2^y for y <= 0, as in the x86 variants.
+inline float32x4_t exp2_nonpositive(float32x4_t y) {
+  y = vmaxq_f32(y, vdupq_n_f32(-126.0f));
+  const float32x4_t n = vrndnq_f32(y);
+  const float32x4_t f = vsubq_f32(y, n);
+  float32x4_t p = vdupq_n_f32(1.540353039e-4f);
+  p = vfmaq_f32(vdupq_n_f32(1.333355815e-3f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(9.618129108e-3f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(5.550410866e-2f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(2.402265070e-1f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(6.931471806e-1f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(1.0f), p, f);
+  const int32x4_t e = vshlq_n_s32(vaddq_s32(vcvtq_s32_f32(n), vdupq_n_s32(127)), 23);
+  return vmulq_f32(p, vreinterpretq_f32_s32(e));
+}
+
+struct Floats8 {
+  float32x4_t lo, hi;
+};
+
+inline Floats8 load8(const uint8_t* p) {
+  uint8x8_t bytes;
+  std::memcpy(&bytes, p, 8);
+  const uint16x8_t wide = vmovl_u8(bytes);
+  return {vcvtq_f32_u32(vmovl_u16(vget_low_u16(wide))), vcvtq_f32_u32(vmovl_u16(vget_high_u16(wide)))};
+}
+
+struct Sums {
+  float32x4_t sum = vdupq_n_f32(0), wsum = vdupq_n_f32(0);
+};
+
+inline void add_tap(float32x4_t v, float32x4_t v0, float32x4_t coeff, float32x4_t log2_space, Sums& s) {
+  const float32x4_t d = vsubq_f32(v, v0);
+  const float32x4_t w = exp2_nonpositive(vfmaq_f32(log2_space, vmulq_f32(d, d), coeff));
+  s.sum = vfmaq_f32(s.sum, w, v);
+  s.wsum = vaddq_f32(s.wsum, w);
+}
+
+inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
+  const Floats8 v0 = load8(c);
+  const float32x4_t coeff = vdupq_n_f32(taps.color_log2_coeff);
+  Sums lo, hi;
+  for (int k = 0; k < taps.count; ++k) {
+    const Floats8 v = load8(c + taps.offset[k]);
+    const float32x4_t log2_space = vdupq_n_f32(taps.log2_space_weight[k]);
+    add_tap(v.lo, v0.lo, coeff, log2_space, lo);
+    add_tap(v.hi, v0.hi, coeff, log2_space, hi);
+  }
+  // Round to nearest even, then 8 values in [0, 255] down to bytes.
+  const uint32x4_t q_lo = vcvtnq_u32_f32(vdivq_f32(lo.sum, lo.wsum));
+  const uint32x4_t q_hi = vcvtnq_u32_f32(vdivq_f32(hi.sum, hi.wsum));
+  const uint8x8_t bytes = vqmovn_u16(vcombine_u16(vqmovn_u32(q_lo), vqmovn_u32(q_hi)));
+  std::memcpy(out, &bytes, 8);
+}
+
+}  // namespace
+
+void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
+  if (width < 8) return scalar::bilateral_row(center, width, taps, out);
+  int x = 0;
+  for (; x + 8 <= width; x += 8) filter8(center + x, taps, out + x);
+  // The last partial block: the final 8 pixels again, overlapping (same values).
+  if (x < width) filter8(center + width - 8, taps, out + width - 8);
+}
+
+}  // namespace ampi::slicing::neon
+#endif  // __aarch64__

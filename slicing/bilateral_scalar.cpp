@@ -1,0 +1,24 @@
+// The scalar reference of the bilateral row (see bilateral_kernels.h).
+#include <cmath>
+#include <cstdlib>
+
+#include "slicing/bilateral_kernels.h"
+
+namespace ampi::slicing::scalar {
+
+void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
+  for (int x = 0; x < width; ++x) {
+    const uint8_t* c = center + x;
+    float sum = 0, wsum = 0;
+    for (int k = 0; k < taps.count; ++k) {
+      const int v = c[taps.offset[k]];
+      const float w = taps.space_weight[k] * taps.color_weight[std::abs(v - c[0])];
+      sum += w * static_cast<float>(v);
+      wsum += w;
+    }
+    // The centre tap has weight 1 * 1, so wsum >= 1 and the ratio lies in [0, 255].
+    out[x] = static_cast<uint8_t>(std::lrint(sum / wsum));
+  }
+}
+
+}  // namespace ampi::slicing::scalar
