@@ -24,17 +24,24 @@ Normalization normalization_of(const cv::Mat& disparity) {
 NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
   const Normalization normalize = normalization_of(disparity);
   // Four tables, pixel x counted in table x % 4, as in level_histogram: neighbours,
-  // which mostly share a level, then update different counters instead of waiting.
-  constexpr int kTables = 4;
-  long long count[kTables][kDisparityLevels] = {};
-  double sum[kTables][kDisparityLevels] = {};
+  // which mostly share a level, then update different counters instead of waiting. A
+  // level's count and sum sit side by side, and each table is padded off a 4 KiB
+  // multiple so that no two tables' counters alias in the CPU's store forwarding.
+  constexpr int kTables = 4, kPaddedLevels = kDisparityLevels + 4;
+  struct Accumulator {
+    long long count = 0;
+    double sum = 0;
+  };
+  std::vector<Accumulator> tables(kTables * kPaddedLevels);
+  Accumulator* table[kTables] = {&tables[0], &tables[kPaddedLevels], &tables[2 * kPaddedLevels],
+                                 &tables[3 * kPaddedLevels]};
   NormalizedLevels out{cv::Mat(disparity.size(), CV_8UC1), {}};
-  auto add = [&](int table, float d, uchar& level) {
+  auto add = [&](int t, float d, uchar& level) {
     const float value = normalize(d);
     const int l = cvRound(value);  // as convertTo: nearest, ties to even
     level = static_cast<uchar>(l);
-    ++count[table][l];
-    sum[table][l] += value;
+    ++table[t][l].count;
+    table[t][l].sum += value;
   };
   for (int y = 0; y < disparity.rows; ++y) {
     const float* in = disparity.ptr<float>(y);
@@ -47,8 +54,8 @@ NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
   out.stats = {std::vector<long long>(kDisparityLevels, 0), std::vector<double>(kDisparityLevels, 0.0)};
   for (int k = 0; k < kTables; ++k)
     for (int l = 0; l < kDisparityLevels; ++l) {
-      out.stats.count[l] += count[k][l];
-      out.stats.sum[l] += sum[k][l];
+      out.stats.count[l] += table[k][l].count;
+      out.stats.sum[l] += table[k][l].sum;
     }
   return out;
 }
