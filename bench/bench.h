@@ -2,6 +2,7 @@
 // prints a table and writes it to bench/RESULTS-WHAT.md.
 #pragma once
 #include <algorithm>
+#include <chrono>
 #include <vector>
 
 namespace ampi::bench {
@@ -10,6 +11,14 @@ namespace ampi::bench {
 inline double median(std::vector<double> v) {
   std::sort(v.begin(), v.end());
   return v.empty() ? 0 : v[v.size() / 2];
+}
+
+// Wall-clock milliseconds of one call of f.
+template <class F>
+double time_ms(F&& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
 // ampi bench kernels [--threads N] [--runs N] [--clock wall|cpu] [--out FILE]: convolution

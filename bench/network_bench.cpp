@@ -70,11 +70,7 @@ std::vector<double> time_runs(DepthNet& net, const Tensor& rgb, ThreadPool& pool
   const int h = static_cast<int>(rgb.dim(0)), w = static_cast<int>(rgb.dim(1));
   for (int i = 0; i < warmup; ++i) *last_output = net.run(rgb.f32(), h, w, pool);
   std::vector<double> ms;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    *last_output = net.run(rgb.f32(), h, w, pool);
-    ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
-  }
+  for (int i = 0; i < runs; ++i) ms.push_back(time_ms([&] { *last_output = net.run(rgb.f32(), h, w, pool); }));
   return ms;
 }
 

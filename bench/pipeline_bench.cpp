@@ -19,11 +19,14 @@
 #include "cli/args.h"
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
+#include "nets/depth_net.h"
 #include "nets/weights_path.h"
+#include "pipeline/depth_estimate.h"
 #include "pipeline/full_resolution.h"
 #include "pipeline/make_mpi.h"
 #include "pipeline/photo_io.h"
 #include "pipeline/video.h"
+#include "slicing/adaptive.h"
 
 namespace fs = std::filesystem;
 
@@ -56,6 +59,8 @@ struct SizeResult {
   double peak_mb = 0;                             // the largest of any stage
   size_t planes = 0;
   cv::Size slicing_size;  // where the depth network's output was sliced
+  // The network alone and the slicer, timed alternately and warm (measure_slicing_share).
+  double warm_network_ms = 0, warm_slicing_ms = 0;
 };
 
 struct RunOutcome {
@@ -113,6 +118,33 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
   return r;
 }
 
+// Issue 6's comparison like for like: the depth network alone on the photo already shrunk
+// to the working size, and the slicer on its output, each timed warm, alternately, `reps`
+// times (medians). The run's stage times differ: there the slicer's buffers are touched
+// for the first time after the heap was handed back (page faults), while the network's
+// arena persists, and the depth stage includes shrinking the photo.
+void measure_slicing_share(const cv::Mat& source, const MpiOptions& options, int reps, SizeResult& r) {
+  DepthNet net = DepthNet::load(options.depth_weights.empty()
+                                    ? find_weights("depth_" + options.depth_model + ".ampw")
+                                    : options.depth_weights);
+  const int side = options.working_size ? options.working_size : net.working_long_side();
+  cv::Mat photo, small;
+  cv::resize(source, photo, r.size, 0, 0, cv::INTER_AREA);
+  const ImageSize work = depth_working_size(photo.rows, photo.cols, side);
+  cv::resize(photo, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+  cv::Mat disparity = estimate_disparity(net, small, side);
+  std::vector<double> network_ms, slicing_ms;
+  for (int k = 0; k <= reps; ++k) {  // k = 0 warms up
+    const double network = time_ms([&] { disparity = estimate_disparity(net, small, side); });
+    const double slicing = time_ms([&] { slice_adaptive(disparity, options.slicing); });
+    if (k == 0) continue;
+    network_ms.push_back(network);
+    slicing_ms.push_back(slicing);
+  }
+  r.warm_network_ms = median(network_ms);
+  r.warm_slicing_ms = median(slicing_ms);
+}
+
 std::string cell(const char* format, double value) {
   char text[48];
   std::snprintf(text, sizeof text, format, value);
@@ -126,6 +158,7 @@ double median_of(const SizeResult& r, const std::string& stage) {
 // Issue 6's target: slicing costs at most this share of the depth network's time at the
 // same resolution.
 constexpr double kSlicingShareTarget = 0.05;
+constexpr int kSlicingShareReps = 30;
 
 std::string table(const std::vector<SizeResult>& results, const MpiOptions& options, int threads,
                   int frames, int runs) {
@@ -173,12 +206,26 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
   md << "\n| depth and slicing ran at |";
   for (const SizeResult& r : results)
     md << " " << r.slicing_size.width << "x" << r.slicing_size.height << " | |";
-  md << "\n| slicing / depth (target <= " << cell("%.0f", 100 * kSlicingShareTarget) << "%) |";
+  md << "\n| slicing / depth stage, in the run |";
   for (const SizeResult& r : results) {
-    const double depth = median_of(r, "depth"), share = depth > 0 ? median_of(r, "slicing") / depth : 0;
+    const double depth = median_of(r, "depth");
+    md << cell(" %.1f%% |", depth > 0 ? 100 * median_of(r, "slicing") / depth : 0) << " |";
+  }
+  md << "\n| depth network alone, warm (ms) |";
+  for (const SizeResult& r : results) md << cell(" %.2f | |", r.warm_network_ms);
+  md << "\n| slicing, warm (ms) |";
+  for (const SizeResult& r : results) md << cell(" %.3f | |", r.warm_slicing_ms);
+  md << "\n| **slicing / depth network, warm** (target <= " << cell("%.0f", 100 * kSlicingShareTarget)
+     << "%) |";
+  for (const SizeResult& r : results) {
+    const double share = r.warm_network_ms > 0 ? r.warm_slicing_ms / r.warm_network_ms : 0;
     md << cell(" %.1f%%", 100 * share) << (share <= kSlicingShareTarget ? " (met)" : " (not met)") << " | |";
   }
-  md << "\n";
+  md << "\n\nThe warm rows time the depth network alone (on the photo already shrunk to the\n"
+     << "working size) and the slicer on its output alternately, " << kSlicingShareReps
+     << " times each, medians: the\ncomparison issue 6 asks for. In the run, the slicer's buffers are touched for the\n"
+     << "first time after the heap was handed back (page faults), while the network's arena\n"
+     << "persists, and the depth stage includes shrinking the photo.\n";
   return md.str();
 }
 
@@ -213,6 +260,7 @@ int pipeline_benchmark(int argc, char** argv) {
     for (cv::Size size : {cv::Size(1024, 768), cv::Size(3840, 2160)}) {
       std::fprintf(stderr, "ampi bench pipeline: %dx%d ...\n", size.width, size.height);
       results.push_back(measure(source, size, runs, options, video, scratch));
+      measure_slicing_share(source, options, kSlicingShareReps, results.back());
     }
   } catch (...) {
     fs::remove_all(scratch);
