@@ -1,9 +1,39 @@
 #include "engine/thread_pool.h"
 
 #include <algorithm>
+#include <chrono>
 #include <memory>
 
+#if defined(__x86_64__)
+#include <immintrin.h>
+#endif
+
 namespace ampi {
+namespace {
+
+// Tells the core this is a spin loop (it yields to a sibling hardware thread and saves
+// power without giving up the time slice).
+inline void cpu_relax() {
+#if defined(__x86_64__)
+  _mm_pause();
+#elif defined(__aarch64__)
+  __asm__ __volatile__("yield");
+#endif
+}
+
+}  // namespace
+
+template <class Done>
+bool ThreadPool::spin_until(Done done) {
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::microseconds(kSpinMicros);
+  for (;;) {
+    for (int i = 0; i < 64; ++i) {
+      if (done()) return true;
+      cpu_relax();
+    }
+    if (std::chrono::steady_clock::now() >= deadline) return done();
+  }
+}
 
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
@@ -42,19 +72,26 @@ void ThreadPool::run_chunks() {
 void ThreadPool::worker_loop() {
   uint64_t seen = 0;
   for (;;) {
+    spin_until([&] { return published_generation_.load(std::memory_order_acquire) != seen; });
     {
       std::unique_lock<std::mutex> lock(mutex_);
-      wake_.wait(lock, [&] { return stopping_ || generation_ != seen; });
+      if (!stopping_ && generation_ == seen) {
+        ++sleeping_workers_;
+        wake_.wait(lock, [&] { return stopping_ || generation_ != seen; });
+        --sleeping_workers_;
+      }
       if (stopping_) return;
       seen = generation_;
-      ++busy_workers_;
+      busy_workers_seen_.store(++busy_workers_, std::memory_order_release);
     }
     run_chunks();
+    bool wake_caller = false;
     {
       std::lock_guard<std::mutex> lock(mutex_);
-      --busy_workers_;
+      busy_workers_seen_.store(--busy_workers_, std::memory_order_release);
+      wake_caller = caller_sleeping_;
     }
-    done_.notify_one();
+    if (wake_caller) done_.notify_one();
   }
 }
 
@@ -69,6 +106,7 @@ void ThreadPool::parallel_for(int64_t count, int64_t grain,
     body(0, count);
     return;
   }
+  bool workers_sleeping = false;
   {
     std::lock_guard<std::mutex> lock(mutex_);
     body_ = &body;
@@ -77,16 +115,23 @@ void ThreadPool::parallel_for(int64_t count, int64_t grain,
     chunks_ = (count + chunk - 1) / chunk;
     next_chunk_ = 0;
     error_ = nullptr;
-    ++generation_;
+    published_generation_.store(++generation_, std::memory_order_release);
+    workers_sleeping = sleeping_workers_ > 0;
   }
-  wake_.notify_all();
+  if (workers_sleeping) wake_.notify_all();
   run_chunks();
+  // Every chunk is now taken (or abandoned after an error); wait for the workers still in
+  // one. Workers that wake late find no chunks left and leave at once.
+  spin_until([&] { return busy_workers_seen_.load(std::memory_order_acquire) == 0; });
   std::exception_ptr error;
   {
     std::unique_lock<std::mutex> lock(mutex_);
-    // Workers that wake late find no chunks left and leave at once; after an error the
-    // remaining chunks are abandoned.
-    done_.wait(lock, [&] { return busy_workers_ == 0 && (next_chunk_ >= chunks_ || error_); });
+    const auto finished = [&] { return busy_workers_ == 0 && (next_chunk_ >= chunks_ || error_); };
+    if (!finished()) {
+      caller_sleeping_ = true;
+      done_.wait(lock, finished);
+      caller_sleeping_ = false;
+    }
     chunks_ = 0;
     body_ = nullptr;
     error = error_;

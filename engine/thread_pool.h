@@ -1,6 +1,13 @@
 // A fixed set of worker threads that split loops between them. The calling thread works
 // too, so a pool of N threads runs N-1 workers; a pool of 1 runs everything inline.
+//
+// A network calls parallel_for once or twice per layer, often only microseconds apart.
+// Sleeping and waking a thread costs a system call each way (more in a virtual machine,
+// where the wake-up is an interrupt to another virtual CPU), so a thread that runs out of
+// work first spins for kSpinMicros, watching for the next job or for the end of the
+// current one, and only then sleeps.
 #pragma once
+#include <atomic>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
@@ -29,6 +36,12 @@ class ThreadPool {
  private:
   void worker_loop();
   void run_chunks();
+  // Spins until done() is true or kSpinMicros pass; returns done().
+  template <class Done>
+  static bool spin_until(Done done);
+
+  // How long an idle thread spins before it sleeps.
+  static constexpr int kSpinMicros = 200;
 
   int threads_;
   std::vector<std::thread> workers_;
@@ -36,6 +49,12 @@ class ThreadPool {
   std::condition_variable wake_, done_;
   bool stopping_ = false;
   uint64_t generation_ = 0;  // bumped for every parallel_for, wakes the workers
+  // Copies of generation_ and busy_workers_ that spinning threads read without the lock;
+  // they take it before acting on what they saw.
+  std::atomic<uint64_t> published_generation_{0};
+  std::atomic<int> busy_workers_seen_{0};
+  int sleeping_workers_ = 0;      // guarded by mutex_
+  bool caller_sleeping_ = false;  // guarded by mutex_
 
   // The job in flight (guarded by the generation handshake).
   const std::function<void(int64_t, int64_t)>* body_ = nullptr;
