@@ -31,21 +31,12 @@ double mass(const std::vector<double>& prefix, int lo, int end) { return prefix[
 }  // namespace
 
 cv::Mat normalize_disparity_float(const cv::Mat& disparity) {
-  const Normalization normalize = normalization_of(disparity);
-  cv::Mat out(disparity.size(), CV_32FC1);
-  for (int y = 0; y < disparity.rows; ++y) {
-    const float* in = disparity.ptr<float>(y);
-    float* v = out.ptr<float>(y);
-    for (int x = 0; x < disparity.cols; ++x) v[x] = normalize(in[x]);
-  }
-  return out;
+  cv::Mat values;
+  normalize_to_levels(disparity, &values);
+  return values;
 }
 
-cv::Mat normalize_disparity(const cv::Mat& disparity) {
-  cv::Mat levels;
-  normalize_disparity_float(disparity).convertTo(levels, CV_8U);  // rounds to nearest
-  return levels;
-}
+cv::Mat normalize_disparity(const cv::Mat& disparity) { return normalize_to_levels(disparity); }
 
 std::vector<double> slicing_histogram(const cv::Mat& normalized, const SlicingParams& p) {
   CV_Assert(normalized.type() == CV_8UC1 && !normalized.empty());

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "slicing/bilateral_kernels.h"
+#include "slicing/row_kernels.h"
 
 namespace ampi {
 namespace {
@@ -37,31 +37,11 @@ void make_tables(const BilateralParams& p, int radius, int64_t row_step, TapTabl
 
 }  // namespace
 
-namespace slicing {
-
-BilateralRowFn bilateral_row_kernel(Isa isa) {
-  if (!isa_runnable(isa))
-    throw std::runtime_error(std::string("bilateral kernels for ") + isa_name(isa) +
-                             " are not runnable on this CPU or build");
-  switch (isa) {
-#if defined(__x86_64__)
-    case Isa::Avx2: return avx2::bilateral_row;
-    case Isa::Avx512: return avx512::bilateral_row;
-#endif
-#if defined(__aarch64__)
-    case Isa::Neon: return neon::bilateral_row;
-#endif
-    default: return scalar::bilateral_row;
-  }
-}
-
-}  // namespace slicing
-
 cv::Mat bilateral_filter_levels(const cv::Mat& levels, const BilateralParams& p, Isa isa, ThreadPool& pool) {
   CV_Assert(levels.type() == CV_8UC1 && !levels.empty());
   if (!(p.diameter >= 1 && p.sigma_color > 0 && p.sigma_space > 0))
     throw std::invalid_argument("bilateral filter: diameter must be at least 1 and the sigmas positive");
-  const slicing::BilateralRowFn row = slicing::bilateral_row_kernel(isa);
+  const slicing::BilateralRowFn row = slicing::slicing_kernels(isa).bilateral_row;
   const int radius = std::max(p.diameter / 2, 1);
   cv::Mat padded;
   cv::copyMakeBorder(levels, padded, radius, radius, radius, radius, cv::BORDER_REFLECT_101);

@@ -1,6 +1,6 @@
 // The slicer's bilateral filter on 8-bit disparity levels: OpenCV's cv::bilateralFilter
 // for CV_8UC1 (the same disk of taps, Gaussian space and colour weights, reflect-101
-// border), computed by our row kernels (slicing/bilateral_kernels.h) over the thread
+// border), computed by our row kernels (slicing/row_kernels.h) over the thread
 // pool. OpenCV's own filter is the slicer's largest cost at the depth network's working
 // size, where the whole slicing step has 5% of the network's time.
 #pragma once
@@ -19,7 +19,7 @@ struct BilateralParams {
 
 // levels: CV_8UC1, not empty. Returns the filtered map (CV_8UC1, same size). The scalar
 // variant equals cv::bilateralFilter(levels, out, diameter, sigma_color, sigma_space);
-// the vector variants may differ from it by one level (slicing/bilateral_kernels.h).
+// the vector variants may differ from it by one level (slicing/row_kernels.h).
 cv::Mat bilateral_filter_levels(const cv::Mat& levels, const BilateralParams& p, Isa isa, ThreadPool& pool);
 // The active instruction set on the default pool.
 cv::Mat bilateral_filter_levels(const cv::Mat& levels, const BilateralParams& p);

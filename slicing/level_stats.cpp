@@ -3,7 +3,9 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "engine/isa.h"
 #include "slicing/adaptive.h"
+#include "slicing/row_kernels.h"
 
 namespace ampi {
 
@@ -21,8 +23,21 @@ Normalization normalization_of(const cv::Mat& disparity) {
   return {lo, hi > lo ? (kDisparityLevels - 1) / (hi - lo) : 0.0};
 }
 
+cv::Mat normalize_to_levels(const cv::Mat& disparity, cv::Mat* values) {
+  const Normalization n = normalization_of(disparity);
+  const slicing::NormalizeRowFn normalize_row = slicing::slicing_kernels(active_isa()).normalize_row;
+  cv::Mat levels(disparity.size(), CV_8UC1);
+  if (values) values->create(disparity.size(), CV_32FC1);
+  std::vector<float> row(values ? 0 : disparity.cols);
+  for (int y = 0; y < disparity.rows; ++y)
+    normalize_row(disparity.ptr<float>(y), disparity.cols, n.lo, n.scale,
+                  values ? values->ptr<float>(y) : row.data(), levels.ptr<uchar>(y));
+  return levels;
+}
+
 NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
-  const Normalization normalize = normalization_of(disparity);
+  const Normalization n = normalization_of(disparity);
+  const slicing::NormalizeRowFn normalize_row = slicing::slicing_kernels(active_isa()).normalize_row;
   // Four tables, pixel x counted in table x % 4, as in level_histogram: neighbours,
   // which mostly share a level, then update different counters instead of waiting. A
   // level's count and sum sit side by side, and each table is padded off a 4 KiB
@@ -35,21 +50,19 @@ NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
   std::vector<Accumulator> tables(kTables * kPaddedLevels);
   Accumulator* table[kTables] = {&tables[0], &tables[kPaddedLevels], &tables[2 * kPaddedLevels],
                                  &tables[3 * kPaddedLevels]};
-  NormalizedLevels out{cv::Mat(disparity.size(), CV_8UC1), {}};
-  auto add = [&](int t, float d, uchar& level) {
-    const float value = normalize(d);
-    const int l = cvRound(value);  // as convertTo: nearest, ties to even
-    level = static_cast<uchar>(l);
+  auto add = [&](int t, uchar l, float value) {
     ++table[t][l].count;
     table[t][l].sum += value;
   };
+  NormalizedLevels out{cv::Mat(disparity.size(), CV_8UC1), {}};
+  std::vector<float> values(disparity.cols);
   for (int y = 0; y < disparity.rows; ++y) {
-    const float* in = disparity.ptr<float>(y);
     uchar* level = out.levels.ptr<uchar>(y);
+    normalize_row(disparity.ptr<float>(y), disparity.cols, n.lo, n.scale, values.data(), level);
     int x = 0;
     for (; x + kTables <= disparity.cols; x += kTables)
-      for (int k = 0; k < kTables; ++k) add(k, in[x + k], level[x + k]);
-    for (; x < disparity.cols; ++x) add(0, in[x], level[x]);
+      for (int k = 0; k < kTables; ++k) add(k, level[x + k], values[x + k]);
+    for (; x < disparity.cols; ++x) add(0, level[x], values[x]);
   }
   out.stats = {std::vector<long long>(kDisparityLevels, 0), std::vector<double>(kDisparityLevels, 0.0)};
   for (int k = 0; k < kTables; ++k)

@@ -2,7 +2,6 @@
 // pass: how many pixels round to each level and the sum of their unrounded values. Plane
 // statistics (pixel count, mean disparity) then cost 256 additions instead of a pass.
 #pragma once
-#include <algorithm>
 #include <opencv2/core.hpp>
 #include <vector>
 
@@ -16,18 +15,20 @@ struct LevelStats {
   std::vector<double> sum;       // of the unrounded normalised values
 };
 
-// Min-max normalisation of a disparity map onto [0, 255]. Offset first, then scale and
-// clamp, in double precision (the difference of any two finite floats is finite there):
-// the extremes land exactly on 0 and 255.
+// Min-max normalisation of a disparity map onto [0, 255]: value = min((d - lo) * scale,
+// 255), in double precision (the difference of any two finite floats is finite there),
+// so the extremes land exactly on 0 and 255; levels are values rounded to nearest, ties
+// to even. scale 0: a constant map, all zeros. Computed by the slicing row kernels
+// (slicing/row_kernels.h), identical on every instruction set.
 struct Normalization {
-  double lo = 0, scale = 0;  // scale 0: a constant map, all zeros
-  float operator()(float d) const {
-    return static_cast<float>(std::min((d - lo) * scale, double(kDisparityLevels - 1)));
-  }
+  double lo = 0, scale = 0;
 };
 // Checks the map (std::invalid_argument if it is empty, not CV_32FC1, or holds NaN or
 // infinite values) and finds its range.
 Normalization normalization_of(const cv::Mat& disparity);
+
+// The map's levels (CV_8UC1), and its values (CV_32FC1) if `values` is not null.
+cv::Mat normalize_to_levels(const cv::Mat& disparity, cv::Mat* values = nullptr);
 
 // The reference: from the levels (CV_8UC1) and the same map before rounding.
 LevelStats level_stats(const cv::Mat& normalized, const cv::Mat& normalized_float);

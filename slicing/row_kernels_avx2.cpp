@@ -1,11 +1,11 @@
-// AVX2 + FMA variant of the bilateral row (see bilateral_kernels.h): 8 pixels at a time,
-// every tap weight one power of two computed in registers.
+// AVX2 + FMA variants of the slicer's row kernels (see row_kernels.h): 8 pixels at a
+// time; the bilateral filter computes every tap weight as one power of two in registers.
 //
 // As in render/composite_avx2.cpp, the ISA is enabled with a target pragma after the
 // standard headers, so no inline function those headers define is compiled for AVX2.
 #include <cstdint>
 
-#include "slicing/bilateral_kernels.h"
+#include "slicing/row_kernels.h"
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -41,6 +41,19 @@ inline __m256 load8(const uint8_t* p) {
   return _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
 }
 
+// 8 int32 in [0, 255] to 8 bytes.
+inline void store8_bytes(__m256i q, uint8_t* out) {
+  const __m256i bytes = _mm256_packus_epi16(_mm256_packus_epi32(q, q), _mm256_setzero_si256());
+  const __m256i gathered = _mm256_permutevar8x32_epi32(bytes, _mm256_setr_epi32(0, 4, 0, 0, 0, 0, 0, 0));
+  _mm_storel_epi64(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(gathered));
+}
+
+// min((x - lo) * scale, 255) on 4 values in double, back to float.
+inline __m128 normalize4(__m128 x, __m256d lo, __m256d scale) {
+  const __m256d v = _mm256_mul_pd(_mm256_sub_pd(_mm256_cvtps_pd(x), lo), scale);
+  return _mm256_cvtpd_ps(_mm256_min_pd(v, _mm256_set1_pd(255.0)));
+}
+
 // Pixels [x, x + 8) of the row.
 inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
   const __m256 v0 = load8(c), coeff = _mm256_set1_ps(taps.color_log2_coeff);
@@ -53,14 +66,24 @@ inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
     sum = _mm256_fmadd_ps(w, v, sum);
     wsum = _mm256_add_ps(wsum, w);
   }
-  // Round to nearest (the default MXCSR mode), then 8 int32 in [0, 255] down to bytes.
-  const __m256i q = _mm256_cvtps_epi32(_mm256_div_ps(sum, wsum));
-  const __m256i bytes = _mm256_packus_epi16(_mm256_packus_epi32(q, q), _mm256_setzero_si256());
-  const __m256i gathered = _mm256_permutevar8x32_epi32(bytes, _mm256_setr_epi32(0, 4, 0, 0, 0, 0, 0, 0));
-  _mm_storel_epi64(reinterpret_cast<__m128i*>(out), _mm256_castsi256_si128(gathered));
+  // Round to nearest (the default MXCSR mode).
+  store8_bytes(_mm256_cvtps_epi32(_mm256_div_ps(sum, wsum)), out);
 }
 
 }  // namespace
+
+void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
+  const __m256d lo4 = _mm256_set1_pd(lo), scale4 = _mm256_set1_pd(scale);
+  int x = 0;
+  for (; x + 8 <= n; x += 8) {
+    const __m256 x8 = _mm256_loadu_ps(in + x);
+    const __m256 v = _mm256_set_m128(normalize4(_mm256_extractf128_ps(x8, 1), lo4, scale4),
+                                     normalize4(_mm256_castps256_ps128(x8), lo4, scale4));
+    _mm256_storeu_ps(value + x, v);
+    store8_bytes(_mm256_cvtps_epi32(v), level + x);  // nearest, ties to even
+  }
+  scalar::normalize_row(in + x, n - x, lo, scale, value + x, level + x);
+}
 
 void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
   if (width < 8) return scalar::bilateral_row(center, width, taps, out);

@@ -1,8 +1,8 @@
-// AVX-512 variant of the bilateral row (see bilateral_kernels.h): 16 pixels at a time,
-// the row's tail under a lane mask.
+// AVX-512 variants of the slicer's row kernels (see row_kernels.h): 16 pixels at a
+// time, the row's tail under a lane mask.
 #include <cstdint>
 
-#include "slicing/bilateral_kernels.h"
+#include "slicing/row_kernels.h"
 
 #if defined(__x86_64__)
 #include <immintrin.h>
@@ -55,7 +55,28 @@ inline void filter16(const uint8_t* c, const BilateralTaps& taps, __mmask16 lane
   _mm_mask_storeu_epi8(out, lanes, _mm512_cvtusepi32_epi8(q));
 }
 
+// min((x - lo) * scale, 255) on 8 values in double, back to float.
+inline __m256 normalize8(__m256 x, __m512d lo, __m512d scale) {
+  const __m512d v = _mm512_mul_pd(_mm512_sub_pd(_mm512_cvtps_pd(x), lo), scale);
+  return _mm512_cvtpd_ps(_mm512_min_pd(v, _mm512_set1_pd(255.0)));
+}
+
 }  // namespace
+
+void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
+  const __m512d lo8 = _mm512_set1_pd(lo), scale8 = _mm512_set1_pd(scale);
+  for (int x = 0; x < n; x += 16) {
+    const __mmask16 lanes = n - x >= 16 ? 0xFFFF : static_cast<__mmask16>((1u << (n - x)) - 1);
+    // Masked-off lanes read lo: 0, defined, never stored.
+    const __m512 x16 = _mm512_mask_loadu_ps(_mm512_set1_ps(static_cast<float>(lo)), lanes, in + x);
+    const __m256 low = normalize8(_mm512_castps512_ps256(x16), lo8, scale8);
+    const __m256 high = normalize8(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(x16), 1)), lo8, scale8);
+    const __m512 v = _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(low)),
+                                                         _mm256_castps_pd(high), 1));
+    _mm512_mask_storeu_ps(value + x, lanes, v);
+    _mm_mask_storeu_epi8(level + x, lanes, _mm512_cvtusepi32_epi8(_mm512_cvtps_epi32(v)));  // ties to even
+  }
+}
 
 void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
   int x = 0;

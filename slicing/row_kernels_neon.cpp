@@ -1,9 +1,10 @@
-// NEON variant of the bilateral row (see bilateral_kernels.h): 8 pixels at a time as two
-// 4-float halves, every tap weight one power of two computed in registers.
+// NEON variants of the slicer's row kernels (see row_kernels.h): 8 pixels at a time as
+// two 4-float halves; the bilateral filter computes every tap weight as one power of two
+// in registers.
 #include <cstdint>
 #include <cstring>
 
-#include "slicing/bilateral_kernels.h"
+#include "slicing/row_kernels.h"
 
 #if defined(__aarch64__)
 #include <arm_neon.h>
@@ -66,7 +67,29 @@ inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
   std::memcpy(out, &bytes, 8);
 }
 
+// min((x - lo) * scale, 255) on 4 values in double, back to float.
+inline float32x4_t normalize4(float32x4_t x, float64x2_t lo, float64x2_t scale) {
+  const float64x2_t top = vdupq_n_f64(255.0);
+  const float64x2_t a = vminq_f64(vmulq_f64(vsubq_f64(vcvt_f64_f32(vget_low_f32(x)), lo), scale), top);
+  const float64x2_t b = vminq_f64(vmulq_f64(vsubq_f64(vcvt_high_f64_f32(x), lo), scale), top);
+  return vcvt_high_f32_f64(vcvt_f32_f64(a), b);
+}
+
 }  // namespace
+
+void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
+  const float64x2_t lo2 = vdupq_n_f64(lo), scale2 = vdupq_n_f64(scale);
+  int x = 0;
+  for (; x + 8 <= n; x += 8) {
+    const float32x4_t a = normalize4(vld1q_f32(in + x), lo2, scale2);
+    const float32x4_t b = normalize4(vld1q_f32(in + x + 4), lo2, scale2);
+    vst1q_f32(value + x, a);
+    vst1q_f32(value + x + 4, b);
+    const uint16x8_t wide = vcombine_u16(vqmovn_u32(vcvtnq_u32_f32(a)), vqmovn_u32(vcvtnq_u32_f32(b)));
+    vst1_u8(level + x, vqmovn_u16(wide));  // nearest, ties to even
+  }
+  scalar::normalize_row(in + x, n - x, lo, scale, value + x, level + x);
+}
 
 void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
   if (width < 8) return scalar::bilateral_row(center, width, taps, out);

@@ -1,8 +1,11 @@
-// Row kernels of the slicer's bilateral filter on 8-bit disparity levels. Pure functions
-// (single-threaded, no allocation); slicing/bilateral.cpp pads the map, splits the rows
-// over the thread pool and calls one kernel per row.
+// Row kernels of the slicer: the normalisation of a disparity map to levels and the
+// bilateral filter on those levels. Pure functions (single-threaded, no allocation);
+// slicing/level_stats.cpp and slicing/bilateral.cpp walk the rows and call one per row.
 //
-// The scalar reference is OpenCV's cv::bilateralFilter for CV_8UC1 step by step: tap
+// normalize_row is the same computation in every variant (double precision, a
+// subtraction then a product, no fused operations), so all variants agree bit for bit.
+//
+// The bilateral scalar reference is OpenCV's cv::bilateralFilter for CV_8UC1 step by step: tap
 // weight = space table * colour table, sums taken tap by tap in float, the ratio rounded
 // to nearest (the tests check it against OpenCV pixel for pixel). The vector variants
 // compute each weight as one power of two, 2^(log2 space weight + coeff * d^2), instead of
@@ -32,25 +35,43 @@ struct BilateralTaps {
 using BilateralRowFn = void (*)(const uint8_t* center, int width, const BilateralTaps& taps,
                                 uint8_t* out);
 
+// For x in [0, n): value[x] = min((in[x] - lo) * scale, 255) computed in double and
+// rounded to float; level[x] = value[x] rounded to the nearest integer, ties to even (as
+// cv::Mat::convertTo rounds). in[x] >= lo and finite.
+using NormalizeRowFn = void (*)(const float* in, int n, double lo, double scale, float* value,
+                                uint8_t* level);
+
+struct SlicingKernels {
+  Isa isa = Isa::Scalar;
+  NormalizeRowFn normalize_row = nullptr;
+  BilateralRowFn bilateral_row = nullptr;
+};
+
 // The variant for an instruction set; throws std::runtime_error if this build or CPU
 // cannot run it.
-BilateralRowFn bilateral_row_kernel(Isa isa);
+SlicingKernels slicing_kernels(Isa isa);
+
+#define AMPI_SLICING_ROW_KERNELS                                                              \
+  void normalize_row(const float* in, int n, double lo, double scale, float* value,           \
+                     uint8_t* level);                                                         \
+  void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);
 
 namespace scalar {
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);
+AMPI_SLICING_ROW_KERNELS
 }
 #if defined(__x86_64__)
 namespace avx2 {
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);
+AMPI_SLICING_ROW_KERNELS
 }
 namespace avx512 {
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);
+AMPI_SLICING_ROW_KERNELS
 }
 #endif
 #if defined(__aarch64__)
 namespace neon {
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);
+AMPI_SLICING_ROW_KERNELS
 }
 #endif
+#undef AMPI_SLICING_ROW_KERNELS
 
 }  // namespace ampi::slicing

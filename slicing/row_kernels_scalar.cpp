@@ -1,10 +1,18 @@
-// The scalar reference of the bilateral row (see bilateral_kernels.h).
+// The scalar references of the slicer's row kernels (see row_kernels.h).
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 
-#include "slicing/bilateral_kernels.h"
+#include "slicing/row_kernels.h"
 
 namespace ampi::slicing::scalar {
+
+void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
+  for (int x = 0; x < n; ++x) {
+    value[x] = static_cast<float>(std::min((in[x] - lo) * scale, 255.0));
+    level[x] = static_cast<uint8_t>(std::nearbyint(value[x]));  // the default mode: ties to even
+  }
+}
 
 void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
   for (int x = 0; x < width; ++x) {
