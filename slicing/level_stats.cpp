@@ -13,13 +13,11 @@ Normalization normalization_of(const cv::Mat& disparity) {
   if (disparity.empty()) throw std::invalid_argument("slicing: the disparity map is empty");
   if (disparity.type() != CV_32FC1)
     throw std::invalid_argument("slicing: the disparity map must be CV_32FC1 (one float channel)");
-  // A finite sum proves every value finite (a NaN or an infinity would spread to it) in
-  // one fast pass; only a sum that is not (extreme values overflow OpenCV's partial
-  // sums) needs checkRange's slower look.
-  if (!std::isfinite(cv::sum(disparity)[0]) && !cv::checkRange(disparity, true))
-    throw std::invalid_argument("slicing: the disparity map contains NaN or infinite values");
-  double lo = 0, hi = 0;
-  cv::minMaxLoc(disparity, &lo, &hi);
+  slicing::ValueRange range{disparity.at<float>(0, 0), disparity.at<float>(0, 0), true};
+  const slicing::RangeRowFn range_row = slicing::slicing_kernels(active_isa()).range_row;
+  for (int y = 0; y < disparity.rows; ++y) range_row(disparity.ptr<float>(y), disparity.cols, range);
+  if (!range.finite) throw std::invalid_argument("slicing: the disparity map contains NaN or infinite values");
+  const double lo = range.lo, hi = range.hi;
   return {lo, hi > lo ? (kDisparityLevels - 1) / (hi - lo) : 0.0};
 }
 

@@ -35,6 +35,14 @@ struct BilateralTaps {
 using BilateralRowFn = void (*)(const uint8_t* center, int width, const BilateralTaps& taps,
                                 uint8_t* out);
 
+// The range of a map, gathered row by row: lo and hi fold in the row's values; finite is
+// cleared if one of them is NaN or infinite (lo and hi then mean nothing).
+struct ValueRange {
+  float lo, hi;
+  bool finite;
+};
+using RangeRowFn = void (*)(const float* in, int n, ValueRange& range);
+
 // For x in [0, n): value[x] = min((in[x] - lo) * scale, 255) computed in double and
 // rounded to float; level[x] = value[x] rounded to the nearest integer, ties to even (as
 // cv::Mat::convertTo rounds). in[x] >= lo and finite.
@@ -43,6 +51,7 @@ using NormalizeRowFn = void (*)(const float* in, int n, double lo, double scale,
 
 struct SlicingKernels {
   Isa isa = Isa::Scalar;
+  RangeRowFn range_row = nullptr;
   NormalizeRowFn normalize_row = nullptr;
   BilateralRowFn bilateral_row = nullptr;
 };
@@ -52,6 +61,7 @@ struct SlicingKernels {
 SlicingKernels slicing_kernels(Isa isa);
 
 #define AMPI_SLICING_ROW_KERNELS                                                              \
+  void range_row(const float* in, int n, ValueRange& range);                                  \
   void normalize_row(const float* in, int n, double lo, double scale, float* value,           \
                      uint8_t* level);                                                         \
   void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);

@@ -72,6 +72,30 @@ inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
 
 }  // namespace
 
+void range_row(const float* in, int n, ValueRange& range) {
+  int x = 0;
+  if (n >= 8) {
+    __m256 lo = _mm256_set1_ps(range.lo), hi = _mm256_set1_ps(range.hi);
+    __m256 finite = _mm256_castsi256_ps(_mm256_set1_epi32(-1));
+    for (; x + 8 <= n; x += 8) {
+      const __m256 v = _mm256_loadu_ps(in + x);
+      // v - v is 0 for a finite v, NaN for an infinite or NaN one.
+      finite = _mm256_and_ps(finite, _mm256_cmp_ps(_mm256_sub_ps(v, v), _mm256_setzero_ps(), _CMP_EQ_OQ));
+      lo = _mm256_min_ps(lo, v);
+      hi = _mm256_max_ps(hi, v);
+    }
+    alignas(32) float los[8], his[8];
+    _mm256_store_ps(los, lo);
+    _mm256_store_ps(his, hi);
+    for (int k = 0; k < 8; ++k) {
+      range.lo = los[k] < range.lo ? los[k] : range.lo;
+      range.hi = his[k] > range.hi ? his[k] : range.hi;
+    }
+    range.finite = range.finite && _mm256_movemask_ps(finite) == 0xFF;
+  }
+  scalar::range_row(in + x, n - x, range);
+}
+
 void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
   const __m256d lo4 = _mm256_set1_pd(lo), scale4 = _mm256_set1_pd(scale);
   int x = 0;

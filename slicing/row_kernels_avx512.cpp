@@ -12,8 +12,10 @@
 #else
 #pragma GCC push_options
 #pragma GCC target("avx512f,avx512bw,avx512vl,fma")
-// GCC 12 warns falsely inside its own masked-load intrinsics (as in cmake/isa.cmake).
+// GCC 12 warns falsely inside its own intrinsics (masked loads, 256-bit extracts), as
+// cmake/isa.cmake notes.
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#pragma GCC diagnostic ignored "-Wuninitialized"
 #endif
 
 namespace ampi::slicing::avx512 {
@@ -62,6 +64,23 @@ inline __m256 normalize8(__m256 x, __m512d lo, __m512d scale) {
 }
 
 }  // namespace
+
+void range_row(const float* in, int n, ValueRange& range) {
+  __m512 lo = _mm512_set1_ps(range.lo), hi = _mm512_set1_ps(range.hi);
+  __mmask16 finite = 0xFFFF;
+  for (int x = 0; x < n; x += 16) {
+    const __mmask16 lanes = n - x >= 16 ? 0xFFFF : static_cast<__mmask16>((1u << (n - x)) - 1);
+    // Masked-off lanes repeat the running minimum: finite, and no new extreme.
+    const __m512 v = _mm512_mask_loadu_ps(_mm512_set1_ps(range.lo), lanes, in + x);
+    // v - v is 0 for a finite v, NaN for an infinite or NaN one.
+    finite &= _mm512_cmp_ps_mask(_mm512_sub_ps(v, v), _mm512_setzero_ps(), _CMP_EQ_OQ);
+    lo = _mm512_min_ps(lo, v);
+    hi = _mm512_max_ps(hi, v);
+  }
+  range.lo = _mm512_reduce_min_ps(lo);
+  range.hi = _mm512_reduce_max_ps(hi);
+  range.finite = range.finite && finite == 0xFFFF;
+}
 
 void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
   const __m512d lo8 = _mm512_set1_pd(lo), scale8 = _mm512_set1_pd(scale);

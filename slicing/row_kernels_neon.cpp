@@ -77,6 +77,25 @@ inline float32x4_t normalize4(float32x4_t x, float64x2_t lo, float64x2_t scale) 
 
 }  // namespace
 
+void range_row(const float* in, int n, ValueRange& range) {
+  int x = 0;
+  if (n >= 4) {
+    float32x4_t lo = vdupq_n_f32(range.lo), hi = vdupq_n_f32(range.hi);
+    uint32x4_t finite = vdupq_n_u32(~0u);
+    for (; x + 4 <= n; x += 4) {
+      const float32x4_t v = vld1q_f32(in + x);
+      // v - v is 0 for a finite v, NaN for an infinite or NaN one.
+      finite = vandq_u32(finite, vceqq_f32(vsubq_f32(v, v), vdupq_n_f32(0.0f)));
+      lo = vminq_f32(lo, v);
+      hi = vmaxq_f32(hi, v);
+    }
+    range.lo = vminvq_f32(lo);
+    range.hi = vmaxvq_f32(hi);
+    range.finite = range.finite && vminvq_u32(finite) == ~0u;
+  }
+  scalar::range_row(in + x, n - x, range);
+}
+
 void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
   const float64x2_t lo2 = vdupq_n_f64(lo), scale2 = vdupq_n_f64(scale);
   int x = 0;

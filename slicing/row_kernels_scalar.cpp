@@ -7,6 +7,14 @@
 
 namespace ampi::slicing::scalar {
 
+void range_row(const float* in, int n, ValueRange& range) {
+  for (int x = 0; x < n; ++x) {
+    range.finite = range.finite && std::isfinite(in[x]);
+    range.lo = std::min(range.lo, in[x]);
+    range.hi = std::max(range.hi, in[x]);
+  }
+}
+
 void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
   for (int x = 0; x < n; ++x) {
     value[x] = static_cast<float>(std::min((in[x] - lo) * scale, 255.0));

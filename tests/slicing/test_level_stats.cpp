@@ -1,5 +1,6 @@
 // The interleaved histogram against its reference (bit for bit equal: slicing's results
 // must not change), and the finiteness check on extreme maps.
+#include <algorithm>
 #include <catch2/catch.hpp>
 #include <limits>
 #include <random>
@@ -98,5 +99,36 @@ TEST_CASE("every normalize_row variant equals the scalar reference bit for bit")
         CHECK(want_level[n - 1] == 255);
         if (n > 1) CHECK(want_level[0] == 0);
       }
+  }
+}
+
+TEST_CASE("every range_row variant finds the scalar range and every non-finite value") {
+  std::mt19937 rng(31);
+  std::uniform_real_distribution<float> value(-1e6f, 1e6f);
+  const float bad[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                       -std::numeric_limits<float>::infinity()};
+  for (Isa isa : runnable_isas()) {
+    const slicing::RangeRowFn range_row = slicing::slicing_kernels(isa).range_row;
+    for (int n : {1, 3, 4, 7, 8, 9, 15, 16, 17, 31, 33, 100}) {
+      std::vector<float> in(n);
+      for (float& v : in) v = value(rng);
+      slicing::ValueRange want{in[0], in[0], true}, got = want;
+      slicing::scalar::range_row(in.data(), n, want);
+      range_row(in.data(), n, got);
+      INFO(isa_name(isa) << " n " << n);
+      REQUIRE(got.finite);
+      CHECK(got.lo == *std::min_element(in.begin(), in.end()));
+      CHECK(got.hi == *std::max_element(in.begin(), in.end()));
+      CHECK(got.lo == want.lo);
+      CHECK(got.hi == want.hi);
+      for (int at = 0; at < n; ++at)  // every position: vector body and tail
+        for (float b : bad) {
+          std::vector<float> spoiled = in;
+          spoiled[at] = b;
+          slicing::ValueRange r{in[0], in[0], true};
+          range_row(spoiled.data(), n, r);
+          REQUIRE_FALSE(r.finite);
+        }
+    }
   }
 }
