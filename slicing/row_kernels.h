@@ -5,13 +5,16 @@
 // normalize_row is the same computation in every variant (double precision, a
 // subtraction then a product, no fused operations), so all variants agree bit for bit.
 //
-// The bilateral scalar reference is OpenCV's cv::bilateralFilter for CV_8UC1 step by step: tap
-// weight = space table * colour table, sums taken tap by tap in float, the ratio rounded
-// to nearest (the tests check it against OpenCV pixel for pixel). The vector variants
-// compute each weight as one power of two, 2^(log2 space weight + coeff * d^2), instead of
-// two table lookups: a gather per tap costs more than the polynomial on the CPUs we
-// measured. Weights then differ from the tables by a few 1e-7 relative, so an output may
-// differ by one level where the ratio lies within that of a half-integer.
+// The bilateral filter weighs each pair of opposite taps once: the weight of tap o at
+// pixel p equals the weight of tap -o at p + o (same distance, same difference of levels).
+// bilateral_weights computes a row of pair weights, bilateral_combine the filtered row
+// from the weights of every tap. The scalar reference builds each weight as OpenCV's
+// cv::bilateralFilter for CV_8UC1 does (space table * colour table) and sums the taps in
+// its order in float, so the filter equals OpenCV's pixel for pixel (tested). The vector
+// variants compute each weight as one power of two, 2^(log2 space weight + coeff * d^2),
+// instead of two table lookups: a gather costs more than the polynomial on the CPUs we
+// measured. Their weights differ from the tables by a few 1e-7 relative, so an output
+// may differ by one level where the ratio lies within that of a half-integer.
 #pragma once
 #include <cstdint>
 
@@ -19,21 +22,35 @@
 
 namespace ampi::slicing {
 
-// The filter's taps, in OpenCV's order (rows top to bottom, columns left to right, only
-// those within the disk of radius diameter / 2).
-struct BilateralTaps {
+// The pairs of opposite taps, one tap o of each (the one after the centre in OpenCV's
+// order: rows top to bottom, columns left to right, within the disk of radius
+// diameter / 2).
+struct BilateralPairs {
   int count = 0;
-  const int64_t* offset = nullptr;          // from the centre pixel, in bytes of the padded map
-  const float* space_weight = nullptr;      // exp(-r^2 / (2 sigma_space^2))
+  const int64_t* offset = nullptr;           // o, in bytes of the padded map
+  const float* space_weight = nullptr;       // exp(-|o|^2 / (2 sigma_space^2))
   const float* log2_space_weight = nullptr;  // log2 of the same (the vector variants)
-  const float* color_weight = nullptr;      // [256]: exp(-d^2 / (2 sigma_color^2))
-  float color_log2_coeff = 0;               // -log2(e) / (2 sigma_color^2)
+  const float* color_weight = nullptr;       // [256]: exp(-d^2 / (2 sigma_color^2))
+  float color_log2_coeff = 0;                // -log2(e) / (2 sigma_color^2)
 };
 
-// out[x] for x in [0, width): the filtered value of the pixel at center[x], whose
-// neighbours center[x + offset[k]] all lie inside the padded map.
-using BilateralRowFn = void (*)(const uint8_t* center, int width, const BilateralTaps& taps,
-                                uint8_t* out);
+// weight[h][x] for x in [0, n): the weight of pair h between the pixels at p[x] and
+// p[x] + offset[h], both inside the padded map.
+using BilateralWeightsFn = void (*)(const uint8_t* p, int n, const BilateralPairs& pairs,
+                                    float* const* weight);
+
+// Every tap of one output row: the tap's offset, and its weights, weight[k][x] for
+// output pixel x (the centre tap's are all 1).
+struct BilateralTaps {
+  int count = 0;
+  const int64_t* offset = nullptr;  // from the centre pixel, in bytes of the padded map
+  const float* const* weight = nullptr;
+};
+
+// out[x] for x in [0, n): sum_k weight[k][x] * center[x + offset[k]] / sum_k weight[k][x],
+// summed in tap order in float, rounded to nearest (ties to even).
+using BilateralCombineFn = void (*)(const uint8_t* center, int n, const BilateralTaps& taps,
+                                    uint8_t* out);
 
 // The range of a map, gathered row by row: lo and hi fold in the row's values; finite is
 // cleared if one of them is NaN or infinite (lo and hi then mean nothing).
@@ -53,7 +70,8 @@ struct SlicingKernels {
   Isa isa = Isa::Scalar;
   RangeRowFn range_row = nullptr;
   NormalizeRowFn normalize_row = nullptr;
-  BilateralRowFn bilateral_row = nullptr;
+  BilateralWeightsFn bilateral_weights = nullptr;
+  BilateralCombineFn bilateral_combine = nullptr;
 };
 
 // The variant for an instruction set; throws std::runtime_error if this build or CPU
@@ -64,7 +82,8 @@ SlicingKernels slicing_kernels(Isa isa);
   void range_row(const float* in, int n, ValueRange& range);                                  \
   void normalize_row(const float* in, int n, double lo, double scale, float* value,           \
                      uint8_t* level);                                                         \
-  void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out);
+  void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight); \
+  void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out);
 
 namespace scalar {
 AMPI_SLICING_ROW_KERNELS

@@ -1,9 +1,10 @@
 // AVX2 + FMA variants of the slicer's row kernels (see row_kernels.h): 8 pixels at a
-// time; the bilateral filter computes every tap weight as one power of two in registers.
+// time; the bilateral weights are powers of two computed in registers.
 //
 // As in render/composite_avx2.cpp, the ISA is enabled with a target pragma after the
 // standard headers, so no inline function those headers define is compiled for AVX2.
 #include <cstdint>
+#include <cstring>
 
 #include "slicing/row_kernels.h"
 
@@ -54,20 +55,34 @@ inline __m128 normalize4(__m128 x, __m256d lo, __m256d scale) {
   return _mm256_cvtpd_ps(_mm256_min_pd(v, _mm256_set1_pd(255.0)));
 }
 
-// Pixels [x, x + 8) of the row.
-inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
-  const __m256 v0 = load8(c), coeff = _mm256_set1_ps(taps.color_log2_coeff);
-  __m256 sum = _mm256_setzero_ps(), wsum = _mm256_setzero_ps();
-  for (int k = 0; k < taps.count; ++k) {
-    const __m256 v = load8(c + taps.offset[k]);
-    const __m256 d = _mm256_sub_ps(v, v0);
-    const __m256 w = exp2_nonpositive(
-        _mm256_fmadd_ps(_mm256_mul_ps(d, d), coeff, _mm256_set1_ps(taps.log2_space_weight[k])));
-    sum = _mm256_fmadd_ps(w, v, sum);
-    wsum = _mm256_add_ps(wsum, w);
-  }
-  // Round to nearest (the default MXCSR mode).
-  store8_bytes(_mm256_cvtps_epi32(_mm256_div_ps(sum, wsum)), out);
+// The first `count` (1..8) bytes at p as floats; lanes past count hold 0. A short block
+// goes through a copy so that nothing past the row is read.
+inline __m256 load_levels(const uint8_t* p, int count) {
+  if (count == 8) return load8(p);
+  uint8_t copy[8] = {};
+  std::memcpy(copy, p, count);
+  return load8(copy);
+}
+
+inline __m256 load_floats(const float* p, int count) {
+  if (count == 8) return _mm256_loadu_ps(p);
+  alignas(32) float copy[8] = {};
+  std::memcpy(copy, p, count * sizeof(float));
+  return _mm256_load_ps(copy);
+}
+
+inline void store_floats(float* p, __m256 v, int count) {
+  if (count == 8) return _mm256_storeu_ps(p, v);
+  alignas(32) float copy[8];
+  _mm256_store_ps(copy, v);
+  std::memcpy(p, copy, count * sizeof(float));
+}
+
+inline void store_levels(uint8_t* p, __m256i q, int count) {
+  if (count == 8) return store8_bytes(q, p);
+  uint8_t copy[8];
+  store8_bytes(q, copy);
+  std::memcpy(p, copy, count);
 }
 
 }  // namespace
@@ -109,12 +124,31 @@ void normalize_row(const float* in, int n, double lo, double scale, float* value
   scalar::normalize_row(in + x, n - x, lo, scale, value + x, level + x);
 }
 
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
-  if (width < 8) return scalar::bilateral_row(center, width, taps, out);
-  int x = 0;
-  for (; x + 8 <= width; x += 8) filter8(center + x, taps, out + x);
-  // The last partial block: the final 8 pixels again, overlapping (same values).
-  if (x < width) filter8(center + width - 8, taps, out + width - 8);
+void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight) {
+  const __m256 coeff = _mm256_set1_ps(pairs.color_log2_coeff);
+  for (int x = 0; x < n; x += 8) {
+    const int count = n - x < 8 ? n - x : 8;
+    const __m256 v0 = load_levels(p + x, count);
+    for (int h = 0; h < pairs.count; ++h) {
+      const __m256 d = _mm256_sub_ps(load_levels(p + x + pairs.offset[h], count), v0);
+      const __m256 y = _mm256_fmadd_ps(_mm256_mul_ps(d, d), coeff, _mm256_set1_ps(pairs.log2_space_weight[h]));
+      store_floats(weight[h] + x, exp2_nonpositive(y), count);
+    }
+  }
+}
+
+void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out) {
+  for (int x = 0; x < n; x += 8) {
+    const int count = n - x < 8 ? n - x : 8;
+    __m256 sum = _mm256_setzero_ps(), wsum = _mm256_setzero_ps();
+    for (int k = 0; k < taps.count; ++k) {
+      const __m256 w = load_floats(taps.weight[k] + x, count);
+      sum = _mm256_fmadd_ps(w, load_levels(center + x + taps.offset[k], count), sum);
+      wsum = _mm256_add_ps(wsum, w);
+    }
+    // Round to nearest (the default MXCSR mode); lanes past count are 0 / 0, not stored.
+    store_levels(out + x, _mm256_cvtps_epi32(_mm256_div_ps(sum, wsum)), count);
+  }
 }
 
 }  // namespace ampi::slicing::avx2

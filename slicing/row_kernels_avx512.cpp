@@ -40,21 +40,9 @@ inline __m512 load16(const uint8_t* p, __mmask16 lanes) {
   return _mm512_cvtepi32_ps(_mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(lanes, p)));
 }
 
-// Pixels [x, x + 16) of the row, those outside `lanes` neither read nor written.
-inline void filter16(const uint8_t* c, const BilateralTaps& taps, __mmask16 lanes, uint8_t* out) {
-  const __m512 v0 = load16(c, lanes), coeff = _mm512_set1_ps(taps.color_log2_coeff);
-  __m512 sum = _mm512_setzero_ps(), wsum = _mm512_setzero_ps();
-  for (int k = 0; k < taps.count; ++k) {
-    const __m512 v = load16(c + taps.offset[k], lanes);
-    const __m512 d = _mm512_sub_ps(v, v0);
-    const __m512 w = exp2_nonpositive(
-        _mm512_fmadd_ps(_mm512_mul_ps(d, d), coeff, _mm512_set1_ps(taps.log2_space_weight[k])));
-    sum = _mm512_fmadd_ps(w, v, sum);
-    wsum = _mm512_add_ps(wsum, w);
-  }
-  // Masked-off lanes hold 0 / w: defined, never stored.
-  const __m512i q = _mm512_cvtps_epi32(_mm512_div_ps(sum, wsum));  // nearest, MXCSR default
-  _mm_mask_storeu_epi8(out, lanes, _mm512_cvtusepi32_epi8(q));
+// The lanes of a block of 16 pixels with `left` pixels left in the row.
+inline __mmask16 lanes_left(int left) {
+  return left >= 16 ? static_cast<__mmask16>(0xFFFF) : static_cast<__mmask16>((1u << left) - 1);
 }
 
 // min((x - lo) * scale, 255) on 8 values in double, back to float.
@@ -69,7 +57,7 @@ void range_row(const float* in, int n, ValueRange& range) {
   __m512 lo = _mm512_set1_ps(range.lo), hi = _mm512_set1_ps(range.hi);
   __mmask16 finite = 0xFFFF;
   for (int x = 0; x < n; x += 16) {
-    const __mmask16 lanes = n - x >= 16 ? 0xFFFF : static_cast<__mmask16>((1u << (n - x)) - 1);
+    const __mmask16 lanes = lanes_left(n - x);
     // Masked-off lanes repeat the running minimum: finite, and no new extreme.
     const __m512 v = _mm512_mask_loadu_ps(_mm512_set1_ps(range.lo), lanes, in + x);
     // v - v is 0 for a finite v, NaN for an infinite or NaN one.
@@ -85,7 +73,7 @@ void range_row(const float* in, int n, ValueRange& range) {
 void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
   const __m512d lo8 = _mm512_set1_pd(lo), scale8 = _mm512_set1_pd(scale);
   for (int x = 0; x < n; x += 16) {
-    const __mmask16 lanes = n - x >= 16 ? 0xFFFF : static_cast<__mmask16>((1u << (n - x)) - 1);
+    const __mmask16 lanes = lanes_left(n - x);
     // Masked-off lanes read lo: 0, defined, never stored.
     const __m512 x16 = _mm512_mask_loadu_ps(_mm512_set1_ps(static_cast<float>(lo)), lanes, in + x);
     const __m256 low = normalize8(_mm512_castps512_ps256(x16), lo8, scale8);
@@ -97,10 +85,32 @@ void normalize_row(const float* in, int n, double lo, double scale, float* value
   }
 }
 
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
-  int x = 0;
-  for (; x + 16 <= width; x += 16) filter16(center + x, taps, 0xFFFF, out + x);
-  if (x < width) filter16(center + x, taps, static_cast<__mmask16>((1u << (width - x)) - 1), out + x);
+void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight) {
+  const __m512 coeff = _mm512_set1_ps(pairs.color_log2_coeff);
+  for (int x = 0; x < n; x += 16) {
+    const __mmask16 lanes = lanes_left(n - x);
+    const __m512 v0 = load16(p + x, lanes);
+    for (int h = 0; h < pairs.count; ++h) {
+      const __m512 d = _mm512_sub_ps(load16(p + x + pairs.offset[h], lanes), v0);
+      const __m512 y = _mm512_fmadd_ps(_mm512_mul_ps(d, d), coeff, _mm512_set1_ps(pairs.log2_space_weight[h]));
+      _mm512_mask_storeu_ps(weight[h] + x, lanes, exp2_nonpositive(y));
+    }
+  }
+}
+
+void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out) {
+  for (int x = 0; x < n; x += 16) {
+    const __mmask16 lanes = lanes_left(n - x);
+    __m512 sum = _mm512_setzero_ps(), wsum = _mm512_setzero_ps();
+    for (int k = 0; k < taps.count; ++k) {
+      const __m512 w = _mm512_maskz_loadu_ps(lanes, taps.weight[k] + x);
+      sum = _mm512_fmadd_ps(w, load16(center + x + taps.offset[k], lanes), sum);
+      wsum = _mm512_add_ps(wsum, w);
+    }
+    // Lanes outside `lanes` are 0 / 0: never stored.
+    const __m512i q = _mm512_cvtps_epi32(_mm512_div_ps(sum, wsum));  // nearest, MXCSR default
+    _mm_mask_storeu_epi8(out + x, lanes, _mm512_cvtusepi32_epi8(q));
+  }
 }
 
 }  // namespace ampi::slicing::avx512

@@ -1,6 +1,5 @@
 // NEON variants of the slicer's row kernels (see row_kernels.h): 8 pixels at a time as
-// two 4-float halves; the bilateral filter computes every tap weight as one power of two
-// in registers.
+// two 4-float halves; the bilateral weights are powers of two computed in registers.
 #include <cstdint>
 #include <cstring>
 
@@ -32,39 +31,32 @@ struct Floats8 {
   float32x4_t lo, hi;
 };
 
-inline Floats8 load8(const uint8_t* p) {
-  uint8x8_t bytes;
-  std::memcpy(&bytes, p, 8);
-  const uint16x8_t wide = vmovl_u8(bytes);
+// The first `count` (1..8) bytes at p as floats; lanes past count hold 0. A short block
+// goes through a copy so that nothing past the row is read.
+inline Floats8 load_levels(const uint8_t* p, int count) {
+  uint8_t copy[8] = {};
+  if (count < 8) std::memcpy(copy, p, count);
+  const uint16x8_t wide = vmovl_u8(vld1_u8(count < 8 ? copy : p));
   return {vcvtq_f32_u32(vmovl_u16(vget_low_u16(wide))), vcvtq_f32_u32(vmovl_u16(vget_high_u16(wide)))};
 }
 
-struct Sums {
-  float32x4_t sum = vdupq_n_f32(0), wsum = vdupq_n_f32(0);
-};
-
-inline void add_tap(float32x4_t v, float32x4_t v0, float32x4_t coeff, float32x4_t log2_space, Sums& s) {
-  const float32x4_t d = vsubq_f32(v, v0);
-  const float32x4_t w = exp2_nonpositive(vfmaq_f32(log2_space, vmulq_f32(d, d), coeff));
-  s.sum = vfmaq_f32(s.sum, w, v);
-  s.wsum = vaddq_f32(s.wsum, w);
+inline Floats8 load_floats(const float* p, int count) {
+  if (count == 8) return {vld1q_f32(p), vld1q_f32(p + 4)};
+  float copy[8] = {};
+  std::memcpy(copy, p, count * sizeof(float));
+  return {vld1q_f32(copy), vld1q_f32(copy + 4)};
 }
 
-inline void filter8(const uint8_t* c, const BilateralTaps& taps, uint8_t* out) {
-  const Floats8 v0 = load8(c);
-  const float32x4_t coeff = vdupq_n_f32(taps.color_log2_coeff);
-  Sums lo, hi;
-  for (int k = 0; k < taps.count; ++k) {
-    const Floats8 v = load8(c + taps.offset[k]);
-    const float32x4_t log2_space = vdupq_n_f32(taps.log2_space_weight[k]);
-    add_tap(v.lo, v0.lo, coeff, log2_space, lo);
-    add_tap(v.hi, v0.hi, coeff, log2_space, hi);
+inline void store_floats(float* p, Floats8 v, int count) {
+  if (count == 8) {
+    vst1q_f32(p, v.lo);
+    vst1q_f32(p + 4, v.hi);
+    return;
   }
-  // Round to nearest even, then 8 values in [0, 255] down to bytes.
-  const uint32x4_t q_lo = vcvtnq_u32_f32(vdivq_f32(lo.sum, lo.wsum));
-  const uint32x4_t q_hi = vcvtnq_u32_f32(vdivq_f32(hi.sum, hi.wsum));
-  const uint8x8_t bytes = vqmovn_u16(vcombine_u16(vqmovn_u32(q_lo), vqmovn_u32(q_hi)));
-  std::memcpy(out, &bytes, 8);
+  float copy[8];
+  vst1q_f32(copy, v.lo);
+  vst1q_f32(copy + 4, v.hi);
+  std::memcpy(p, copy, count * sizeof(float));
 }
 
 // min((x - lo) * scale, 255) on 4 values in double, back to float.
@@ -110,12 +102,42 @@ void normalize_row(const float* in, int n, double lo, double scale, float* value
   scalar::normalize_row(in + x, n - x, lo, scale, value + x, level + x);
 }
 
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
-  if (width < 8) return scalar::bilateral_row(center, width, taps, out);
-  int x = 0;
-  for (; x + 8 <= width; x += 8) filter8(center + x, taps, out + x);
-  // The last partial block: the final 8 pixels again, overlapping (same values).
-  if (x < width) filter8(center + width - 8, taps, out + width - 8);
+void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight) {
+  const float32x4_t coeff = vdupq_n_f32(pairs.color_log2_coeff);
+  auto weigh = [&](float32x4_t v, float32x4_t v0, float32x4_t log2_space) {
+    const float32x4_t d = vsubq_f32(v, v0);
+    return exp2_nonpositive(vfmaq_f32(log2_space, vmulq_f32(d, d), coeff));
+  };
+  for (int x = 0; x < n; x += 8) {
+    const int count = n - x < 8 ? n - x : 8;
+    const Floats8 v0 = load_levels(p + x, count);
+    for (int h = 0; h < pairs.count; ++h) {
+      const Floats8 v = load_levels(p + x + pairs.offset[h], count);
+      const float32x4_t log2_space = vdupq_n_f32(pairs.log2_space_weight[h]);
+      store_floats(weight[h] + x, {weigh(v.lo, v0.lo, log2_space), weigh(v.hi, v0.hi, log2_space)}, count);
+    }
+  }
+}
+
+void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out) {
+  for (int x = 0; x < n; x += 8) {
+    const int count = n - x < 8 ? n - x : 8;
+    float32x4_t sum_lo = vdupq_n_f32(0), sum_hi = sum_lo, wsum_lo = sum_lo, wsum_hi = sum_lo;
+    for (int k = 0; k < taps.count; ++k) {
+      const Floats8 w = load_floats(taps.weight[k] + x, count);
+      const Floats8 v = load_levels(center + x + taps.offset[k], count);
+      sum_lo = vfmaq_f32(sum_lo, w.lo, v.lo);
+      sum_hi = vfmaq_f32(sum_hi, w.hi, v.hi);
+      wsum_lo = vaddq_f32(wsum_lo, w.lo);
+      wsum_hi = vaddq_f32(wsum_hi, w.hi);
+    }
+    // Round to nearest even; lanes past count are 0 / 0, not stored.
+    const uint32x4_t q_lo = vcvtnq_u32_f32(vdivq_f32(sum_lo, wsum_lo));
+    const uint32x4_t q_hi = vcvtnq_u32_f32(vdivq_f32(sum_hi, wsum_hi));
+    uint8_t bytes[8];
+    vst1_u8(bytes, vqmovn_u16(vcombine_u16(vqmovn_u32(q_lo), vqmovn_u32(q_hi))));
+    std::memcpy(out + x, bytes, count);
+  }
 }
 
 }  // namespace ampi::slicing::neon

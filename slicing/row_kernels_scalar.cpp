@@ -22,17 +22,21 @@ void normalize_row(const float* in, int n, double lo, double scale, float* value
   }
 }
 
-void bilateral_row(const uint8_t* center, int width, const BilateralTaps& taps, uint8_t* out) {
-  for (int x = 0; x < width; ++x) {
-    const uint8_t* c = center + x;
+void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight) {
+  for (int h = 0; h < pairs.count; ++h)
+    for (int x = 0; x < n; ++x)
+      weight[h][x] = pairs.space_weight[h] * pairs.color_weight[std::abs(p[x + pairs.offset[h]] - p[x])];
+}
+
+void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out) {
+  for (int x = 0; x < n; ++x) {
     float sum = 0, wsum = 0;
     for (int k = 0; k < taps.count; ++k) {
-      const int v = c[taps.offset[k]];
-      const float w = taps.space_weight[k] * taps.color_weight[std::abs(v - c[0])];
-      sum += w * static_cast<float>(v);
+      const float w = taps.weight[k][x];
+      sum += w * static_cast<float>(center[x + taps.offset[k]]);
       wsum += w;
     }
-    // The centre tap has weight 1 * 1, so wsum >= 1 and the ratio lies in [0, 255].
+    // The centre tap weighs 1, so wsum >= 1 and the ratio lies in [0, 255].
     out[x] = static_cast<uint8_t>(std::lrint(sum / wsum));
   }
 }

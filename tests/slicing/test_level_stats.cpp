@@ -8,7 +8,6 @@
 
 #include "slicing/adaptive.h"
 #include "slicing/level_stats.h"
-#include "slicing/row_kernels.h"
 
 using namespace ampi;
 
@@ -73,62 +72,4 @@ TEST_CASE("normalize_with_stats equals the float map's levels and their referenc
   }
   CHECK_THROWS_AS(normalize_with_stats(cv::Mat()), std::invalid_argument);
   CHECK_THROWS_AS(normalize_with_stats(cv::Mat(2, 2, CV_8UC1)), std::invalid_argument);
-}
-
-TEST_CASE("every normalize_row variant equals the scalar reference bit for bit") {
-  std::mt19937 rng(21);
-  std::uniform_real_distribution<float> unit(0.0f, 1.0f);
-  // (lo, hi) ranges: ordinary, narrow at a large offset, and the whole float range.
-  const std::pair<float, float> ranges[] = {{-2.0f, 7.0f}, {1000.0f, 1000.5f}, {-3e38f, 3e38f}};
-  for (Isa isa : runnable_isas()) {
-    const slicing::SlicingKernels kernels = slicing::slicing_kernels(isa);
-    for (auto [lo, hi] : ranges)
-      for (int n : {1, 3, 4, 7, 8, 9, 15, 16, 17, 31, 33, 100}) {
-        std::vector<float> in(n);
-        for (float& v : in) v = lo + unit(rng) * (hi - lo);
-        in[0] = lo;
-        in[n - 1] = hi;
-        const double scale = 255.0 / (double(hi) - double(lo));
-        std::vector<float> want_value(n), got_value(n);
-        std::vector<uint8_t> want_level(n), got_level(n);
-        slicing::scalar::normalize_row(in.data(), n, lo, scale, want_value.data(), want_level.data());
-        kernels.normalize_row(in.data(), n, lo, scale, got_value.data(), got_level.data());
-        INFO(isa_name(isa) << " range " << lo << ".." << hi << " n " << n);
-        REQUIRE(got_value == want_value);
-        REQUIRE(got_level == want_level);
-        CHECK(want_level[n - 1] == 255);
-        if (n > 1) CHECK(want_level[0] == 0);
-      }
-  }
-}
-
-TEST_CASE("every range_row variant finds the scalar range and every non-finite value") {
-  std::mt19937 rng(31);
-  std::uniform_real_distribution<float> value(-1e6f, 1e6f);
-  const float bad[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
-                       -std::numeric_limits<float>::infinity()};
-  for (Isa isa : runnable_isas()) {
-    const slicing::RangeRowFn range_row = slicing::slicing_kernels(isa).range_row;
-    for (int n : {1, 3, 4, 7, 8, 9, 15, 16, 17, 31, 33, 100}) {
-      std::vector<float> in(n);
-      for (float& v : in) v = value(rng);
-      slicing::ValueRange want{in[0], in[0], true}, got = want;
-      slicing::scalar::range_row(in.data(), n, want);
-      range_row(in.data(), n, got);
-      INFO(isa_name(isa) << " n " << n);
-      REQUIRE(got.finite);
-      CHECK(got.lo == *std::min_element(in.begin(), in.end()));
-      CHECK(got.hi == *std::max_element(in.begin(), in.end()));
-      CHECK(got.lo == want.lo);
-      CHECK(got.hi == want.hi);
-      for (int at = 0; at < n; ++at)  // every position: vector body and tail
-        for (float b : bad) {
-          std::vector<float> spoiled = in;
-          spoiled[at] = b;
-          slicing::ValueRange r{in[0], in[0], true};
-          range_row(spoiled.data(), n, r);
-          REQUIRE_FALSE(r.finite);
-        }
-    }
-  }
 }
