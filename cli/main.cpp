@@ -7,6 +7,7 @@
 #include <string>
 
 #include "cli/commands.h"
+#include "pipeline/opencv_threads.h"
 
 namespace {
 
@@ -34,6 +35,7 @@ void print_usage(FILE* out) {
 }  // namespace
 
 int main(int argc, char** argv) {
+  ampi::run_opencv_on_default_pool();
   if (argc < 2) {
     print_usage(stderr);
     return 2;

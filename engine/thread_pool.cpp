@@ -21,7 +21,13 @@ inline void cpu_relax() {
 #endif
 }
 
+// Set for a pool's workers for life, and for a caller while its loop runs.
+thread_local bool t_inside_loop = false;
+thread_local int t_worker_index = 0;
+
 }  // namespace
+
+int ThreadPool::thread_index() { return t_worker_index; }
 
 template <class Done>
 bool ThreadPool::spin_until(Done done) {
@@ -38,7 +44,12 @@ bool ThreadPool::spin_until(Done done) {
 ThreadPool::ThreadPool(int threads) {
   if (threads <= 0) threads = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   threads_ = threads;
-  for (int i = 1; i < threads_; ++i) workers_.emplace_back([this] { worker_loop(); });
+  for (int i = 1; i < threads_; ++i)
+    workers_.emplace_back([this, i] {
+      t_inside_loop = true;
+      t_worker_index = i;
+      worker_loop();
+    });
 }
 
 ThreadPool::~ThreadPool() {
@@ -102,7 +113,7 @@ void ThreadPool::parallel_for(int64_t count, int64_t grain,
   // A few chunks per thread balances uneven work without much locking.
   const int64_t max_chunks = static_cast<int64_t>(threads_) * 4;
   int64_t chunk = std::max(grain, (count + max_chunks - 1) / max_chunks);
-  if (threads_ == 1 || count <= grain) {
+  if (threads_ == 1 || count <= grain || t_inside_loop) {
     body(0, count);
     return;
   }
@@ -119,7 +130,9 @@ void ThreadPool::parallel_for(int64_t count, int64_t grain,
     workers_sleeping = sleeping_workers_ > 0;
   }
   if (workers_sleeping) wake_.notify_all();
+  t_inside_loop = true;
   run_chunks();
+  t_inside_loop = false;
   // Every chunk is now taken (or abandoned after an error); wait for the workers still in
   // one. Workers that wake late find no chunks left and leave at once.
   spin_until([&] { return busy_workers_seen_.load(std::memory_order_acquire) == 0; });

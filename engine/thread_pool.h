@@ -29,9 +29,15 @@ class ThreadPool {
 
   // Calls body(begin, end) on disjoint sub-ranges covering [0, count), each at least
   // `grain` long (except the last), spread over the pool's threads. Returns when all are
-  // done; the first exception thrown by a body is rethrown here.
+  // done; the first exception thrown by a body is rethrown here. Called from inside a
+  // body (of any pool), it runs body(0, count) on the calling thread: nested loops do not
+  // queue behind the loop that is waiting for them.
   void parallel_for(int64_t count, int64_t grain,
                     const std::function<void(int64_t, int64_t)>& body);
+
+  // The calling thread's index among those running a loop: 1..N-1 for a pool's workers,
+  // 0 for any other thread (a loop's caller works as thread 0).
+  static int thread_index();
 
  private:
   void worker_loop();
