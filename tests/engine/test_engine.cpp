@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <stdexcept>
+#include <thread>
 #include <vector>
 
 #include "engine/arena.h"
@@ -88,6 +89,26 @@ TEST_CASE("parallel_for rethrows a body's exception and stays usable") {
   std::atomic<int64_t> sum{0};
   pool.parallel_for(100, 1, [&](int64_t b, int64_t e) { sum += e - b; });
   CHECK(sum == 100);
+}
+
+TEST_CASE("a loop inside a loop runs inline on the calling thread; thread indices are in range") {
+  ThreadPool pool(2);
+  std::atomic<int64_t> inner_total{0};
+  std::atomic<int> bad_index{0}, moved_thread{0};
+  pool.parallel_for(8, 1, [&](int64_t b, int64_t e) {
+    const int index = ThreadPool::thread_index();
+    if (index < 0 || index >= pool.size()) ++bad_index;
+    const auto outer_thread = std::this_thread::get_id();
+    for (int64_t i = b; i < e; ++i)
+      pool.parallel_for(100, 1, [&](int64_t ib, int64_t ie) {
+        if (std::this_thread::get_id() != outer_thread) ++moved_thread;
+        inner_total += ie - ib;
+      });
+  });
+  CHECK(inner_total == 800);
+  CHECK(bad_index == 0);
+  CHECK(moved_thread == 0);
+  CHECK(ThreadPool::thread_index() == 0);  // the caller, outside a loop
 }
 
 TEST_CASE("instruction sets: scalar always runs, names parse, detection is consistent") {
