@@ -7,6 +7,7 @@
 #include <string>
 
 #include "slicing/bilateral.h"
+#include "slicing/canny.h"
 #include "slicing/level_stats.h"
 
 namespace ampi {
@@ -42,8 +43,8 @@ std::vector<double> slicing_histogram(const cv::Mat& normalized, const SlicingPa
   CV_Assert(normalized.type() == CV_8UC1 && !normalized.empty());
   const cv::Mat filtered = bilateral_filter_levels(
       normalized, {p.bilateral_diameter, p.bilateral_sigma_color, p.bilateral_sigma_space});
-  cv::Mat edges, band;
-  cv::Canny(filtered, edges, p.canny_low, p.canny_high);
+  const cv::Mat edges = canny_edges(filtered, p.canny_low, p.canny_high);
+  cv::Mat band;
   // The paper's "erosion" of the borders: eroding the map's non-edge region is dilating
   // the edge band. Leaving the band out deepens the valleys between depth clusters.
   const cv::Mat element = cv::getStructuringElement(

@@ -1,0 +1,114 @@
+#include "slicing/canny.h"
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <opencv2/core.hpp>
+#include <stdexcept>
+#include <vector>
+
+namespace ampi {
+namespace {
+
+// The pixel states of the edge map, as OpenCV's Canny keeps them.
+enum : uint8_t { kCandidate = 0, kNotEdge = 1, kEdge = 2 };
+
+// tan(22.5 degrees) in 15-bit fixed point: the direction test of OpenCV's Canny.
+constexpr int kShift = 15;
+constexpr int kTan22 = 13573;  // round(0.41421356 * 2^15)
+
+// Sobel gradients and their L1 magnitude for one row of the image (replicated borders:
+// `padded` has one extra pixel on every side). mag has one zero column on each side. All
+// fit 16 bits (|dx|, |dy| <= 1020), and the loop is written so the compiler vectorises it.
+void gradient_row(const cv::Mat& padded, int y, int16_t* __restrict dx, int16_t* __restrict dy,
+                  int16_t* __restrict mag) {
+  const int w = padded.cols - 2;
+  const uint8_t* __restrict above = padded.ptr<uint8_t>(y);  // padded row y is image row y - 1
+  const uint8_t* __restrict here = padded.ptr<uint8_t>(y + 1);
+  const uint8_t* __restrict below = padded.ptr<uint8_t>(y + 2);
+  for (int x = 0; x < w; ++x) {  // padded column x + 1 is image column x
+    const int16_t gx = static_cast<int16_t>((above[x + 2] + 2 * here[x + 2] + below[x + 2]) -
+                                            (above[x] + 2 * here[x] + below[x]));
+    const int16_t gy = static_cast<int16_t>((below[x] + 2 * below[x + 1] + below[x + 2]) -
+                                            (above[x] + 2 * above[x + 1] + above[x + 2]));
+    dx[x] = gx;
+    dy[x] = gy;
+    mag[x + 1] = static_cast<int16_t>((gx < 0 ? -gx : gx) + (gy < 0 ? -gy : gy));
+  }
+  mag[0] = mag[w + 1] = 0;
+}
+
+// Whether a pixel of magnitude m is a local maximum across its edge: along the gradient's
+// direction, quantised to horizontal, vertical or one of the diagonals. One side compares
+// strictly, the other not, so a plateau keeps exactly one pixel (OpenCV's choice).
+bool local_max(int m, int gx, int gy, const int16_t* prev, const int16_t* cur, const int16_t* next, int j) {
+  const int x = std::abs(gx), y = std::abs(gy) << kShift;
+  const int tg22x = x * kTan22;
+  if (y < tg22x) return m > cur[j - 1] && m >= cur[j + 1];
+  const int tg67x = tg22x + (x << (kShift + 1));
+  if (y > tg67x) return m > prev[j] && m >= next[j];
+  const int s = (gx ^ gy) < 0 ? -1 : 1;
+  return m > prev[j - s] && m > next[j + s];
+}
+
+}  // namespace
+
+cv::Mat canny_edges(const cv::Mat& levels, double low_threshold, double high_threshold) {
+  CV_Assert(levels.type() == CV_8UC1 && !levels.empty());
+  if (!(low_threshold >= 0 && high_threshold >= low_threshold))
+    throw std::invalid_argument("Canny thresholds must satisfy 0 <= low <= high");
+  const int low = static_cast<int>(std::floor(low_threshold));
+  const int high = static_cast<int>(std::floor(high_threshold));
+  const int w = levels.cols, h = levels.rows, map_step = w + 2;
+  cv::Mat padded;
+  cv::copyMakeBorder(levels, padded, 1, 1, 1, 1, cv::BORDER_REPLICATE);
+  // The edge map with a border of kNotEdge; magnitudes of rows y - 1, y, y + 1, with
+  // zero rows above and below the image.
+  std::vector<uint8_t> map(static_cast<size_t>(map_step) * (h + 2), kNotEdge);
+  std::vector<int16_t> mags(3 * static_cast<size_t>(map_step), 0);
+  std::vector<int16_t> grads(4 * static_cast<size_t>(w));
+  int16_t* mag[3] = {&mags[0], &mags[map_step], &mags[2 * map_step]};  // prev, cur, next
+  int16_t* dx[2] = {&grads[0], &grads[2 * w]};                         // cur, next
+  int16_t* dy[2] = {&grads[w], &grads[3 * w]};
+  std::vector<uint8_t*> stack;
+  gradient_row(padded, 0, dx[1], dy[1], mag[2]);
+  for (int y = 0; y < h; ++y) {
+    std::swap(mag[0], mag[1]);
+    std::swap(mag[1], mag[2]);
+    std::swap(dx[0], dx[1]);
+    std::swap(dy[0], dy[1]);
+    if (y + 1 < h)
+      gradient_row(padded, y + 1, dx[1], dy[1], mag[2]);
+    else
+      std::fill(mag[2], mag[2] + map_step, 0);
+    if (y == 0) std::fill(mag[0], mag[0] + map_step, 0);
+    uint8_t* row = &map[static_cast<size_t>(y + 1) * map_step + 1];
+    for (int x = 0; x < w; ++x) {
+      const int m = mag[1][x + 1];
+      if (m <= low || !local_max(m, dx[0][x], dy[0][x], mag[0], mag[1], mag[2], x + 1)) continue;
+      row[x] = m > high ? kEdge : kCandidate;
+      if (m > high) stack.push_back(row + x);
+    }
+  }
+  // Hysteresis: candidates 8-connected to an edge become edges.
+  const std::ptrdiff_t neighbours[8] = {-map_step - 1, -map_step, -map_step + 1, -1, 1,
+                                        map_step - 1,  map_step,  map_step + 1};
+  while (!stack.empty()) {
+    uint8_t* p = stack.back();
+    stack.pop_back();
+    for (std::ptrdiff_t d : neighbours)
+      if (p[d] == kCandidate) {
+        p[d] = kEdge;
+        stack.push_back(p + d);
+      }
+  }
+  cv::Mat edges(levels.size(), CV_8UC1);
+  for (int y = 0; y < h; ++y) {
+    const uint8_t* row = &map[static_cast<size_t>(y + 1) * map_step + 1];
+    uint8_t* out = edges.ptr<uint8_t>(y);
+    for (int x = 0; x < w; ++x) out[x] = row[x] == kEdge ? 255 : 0;
+  }
+  return edges;
+}
+
+}  // namespace ampi
