@@ -7,7 +7,7 @@
 #include <string>
 
 #include "slicing/bilateral.h"
-#include "slicing/canny.h"
+#include "slicing/edges.h"
 #include "slicing/level_stats.h"
 
 namespace ampi {
@@ -44,12 +44,9 @@ std::vector<double> slicing_histogram(const cv::Mat& normalized, const SlicingPa
   const cv::Mat filtered = bilateral_filter_levels(
       normalized, {p.bilateral_diameter, p.bilateral_sigma_color, p.bilateral_sigma_space});
   const cv::Mat edges = canny_edges(filtered, p.canny_low, p.canny_high);
-  cv::Mat band;
   // The paper's "erosion" of the borders: eroding the map's non-edge region is dilating
   // the edge band. Leaving the band out deepens the valleys between depth clusters.
-  const cv::Mat element = cv::getStructuringElement(
-      cv::MORPH_RECT, cv::Size(p.border_erosion_size, p.border_erosion_size));
-  cv::dilate(edges, band, element);
+  const cv::Mat band = widen_edges(edges, p.border_erosion_size);
   std::vector<double> h = level_histogram(filtered, band);
   if (static_cast<size_t>(cv::countNonZero(band)) == band.total()) h = level_histogram(filtered, cv::Mat());
   return h;

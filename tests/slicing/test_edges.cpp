@@ -1,10 +1,10 @@
-// Our Canny (slicing/canny.h) against cv::Canny (3x3 Sobel, L1 norm) pixel for pixel.
+// Our Canny (slicing/edges.h) against cv::Canny (3x3 Sobel, L1 norm) pixel for pixel.
 #include <catch2/catch.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 #include <string>
 
-#include "slicing/canny.h"
+#include "slicing/edges.h"
 
 using namespace ampi;
 
@@ -49,4 +49,19 @@ TEST_CASE("canny_edges refuses bad thresholds") {
   const cv::Mat levels(4, 4, CV_8UC1, cv::Scalar(1));
   CHECK_THROWS_AS(canny_edges(levels, -1, 5), std::invalid_argument);
   CHECK_THROWS_AS(canny_edges(levels, 6, 5), std::invalid_argument);
+}
+
+TEST_CASE("widen_edges equals cv::dilate with a square element") {
+  cv::RNG rng(7);
+  for (cv::Size size : {cv::Size(1, 1), cv::Size(2, 3), cv::Size(9, 4), cv::Size(40, 31), cv::Size(256, 192)})
+    for (int k : {1, 2, 3, 4, 7, 8, 15})
+      for (double density : {0.0, 0.01, 0.2}) {
+        cv::Mat noise(size, CV_32FC1), mask;
+        rng.fill(noise, cv::RNG::UNIFORM, 0.0, 1.0);
+        mask = noise < density;  // 0 or 255
+        cv::Mat expected;
+        cv::dilate(mask, expected, cv::getStructuringElement(cv::MORPH_RECT, {k, k}));
+        INFO(size.width << "x" << size.height << " element " << k << " density " << density);
+        REQUIRE(cv::countNonZero(widen_edges(mask, k) != expected) == 0);
+      }
 }

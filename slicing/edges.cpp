@@ -1,5 +1,6 @@
-#include "slicing/canny.h"
+#include "slicing/edges.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -109,6 +110,48 @@ cv::Mat canny_edges(const cv::Mat& levels, double low_threshold, double high_thr
     for (int x = 0; x < w; ++x) out[x] = row[x] == kEdge ? 255 : 0;
   }
   return edges;
+}
+
+namespace {
+
+// row_any[x] = whether row[x - anchor .. x - anchor + size - 1] (clipped to the row)
+// holds a nonzero pixel: a count of them slides along the row.
+void any_in_row_window(const uint8_t* row, int w, int size, int anchor, uint8_t* row_any) {
+  int count = 0;
+  for (int x = 0; x < std::min(w, size - 1 - anchor); ++x) count += row[x] != 0;
+  for (int x = 0; x < w; ++x) {
+    const int enter = x - anchor + size - 1, leave = x - anchor - 1;
+    if (enter < w) count += row[enter] != 0;
+    if (leave >= 0) count -= row[leave] != 0;
+    row_any[x] = count > 0;
+  }
+}
+
+}  // namespace
+
+cv::Mat widen_edges(const cv::Mat& mask, int size) {
+  CV_Assert(mask.type() == CV_8UC1 && !mask.empty() && size >= 1);
+  const int w = mask.cols, h = mask.rows, anchor = size / 2;
+  // Rows' window results for the rows in the vertical window (a ring of `size` rows),
+  // and per column how many of them are set.
+  std::vector<uint8_t> ring(static_cast<size_t>(size) * w);
+  std::vector<int> count(w, 0);
+  auto row_any = [&](int r) { return &ring[static_cast<size_t>(r % size) * w]; };
+  auto enter = [&](int r) {
+    any_in_row_window(mask.ptr<uint8_t>(r), w, size, anchor, row_any(r));
+    for (int x = 0; x < w; ++x) count[x] += row_any(r)[x];
+  };
+  for (int r = 0; r < std::min(h, size - 1 - anchor); ++r) enter(r);
+  cv::Mat band(mask.size(), CV_8UC1);
+  for (int y = 0; y < h; ++y) {  // window rows [y - anchor, y - anchor + size - 1]
+    if (y - anchor + size - 1 < h) enter(y - anchor + size - 1);
+    uint8_t* out = band.ptr<uint8_t>(y);
+    for (int x = 0; x < w; ++x) out[x] = count[x] > 0 ? 255 : 0;
+    const int leave = y - anchor;  // not in the next row's window
+    if (leave >= 0)
+      for (int x = 0; x < w; ++x) count[x] -= row_any(leave)[x];
+  }
+  return band;
 }
 
 }  // namespace ampi
