@@ -8,6 +8,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "engine/thread_pool.h"
+
 namespace ampi {
 namespace {
 
@@ -52,6 +54,38 @@ bool local_max(int m, int gx, int gy, const int16_t* prev, const int16_t* cur, c
   return m > prev[j - s] && m > next[j + s];
 }
 
+// Non-maximum suppression of image rows [begin, end): marks the map's local maxima above
+// `low` as candidates, those above `high` as edges (pushed on `strong`). Keeps three rows
+// of magnitudes (rows outside the image count 0) and two of gradients.
+void suppress_rows(const cv::Mat& padded, int low, int high, int begin, int end, uint8_t* map,
+                   std::vector<uint8_t*>& strong) {
+  const int w = padded.cols - 2, h = padded.rows - 2, map_step = w + 2;
+  std::vector<int16_t> mags(3 * static_cast<size_t>(map_step), 0);
+  std::vector<int16_t> grads(4 * static_cast<size_t>(w));
+  int16_t* mag[3] = {&mags[0], &mags[map_step], &mags[2 * map_step]};  // prev, cur, next
+  int16_t* dx[2] = {&grads[0], &grads[2 * w]};                         // cur, next
+  int16_t* dy[2] = {&grads[w], &grads[3 * w]};
+  if (begin > 0) gradient_row(padded, begin - 1, dx[1], dy[1], mag[1]);  // becomes prev
+  gradient_row(padded, begin, dx[1], dy[1], mag[2]);
+  for (int y = begin; y < end; ++y) {
+    std::swap(mag[0], mag[1]);
+    std::swap(mag[1], mag[2]);
+    std::swap(dx[0], dx[1]);
+    std::swap(dy[0], dy[1]);
+    if (y + 1 < h)
+      gradient_row(padded, y + 1, dx[1], dy[1], mag[2]);
+    else
+      std::fill(mag[2], mag[2] + map_step, 0);
+    uint8_t* row = map + static_cast<size_t>(y + 1) * map_step + 1;
+    for (int x = 0; x < w; ++x) {
+      const int m = mag[1][x + 1];
+      if (m <= low || !local_max(m, dx[0][x], dy[0][x], mag[0], mag[1], mag[2], x + 1)) continue;
+      row[x] = m > high ? kEdge : kCandidate;
+      if (m > high) strong.push_back(row + x);
+    }
+  }
+}
+
 }  // namespace
 
 cv::Mat canny_edges(const cv::Mat& levels, double low_threshold, double high_threshold) {
@@ -63,34 +97,19 @@ cv::Mat canny_edges(const cv::Mat& levels, double low_threshold, double high_thr
   const int w = levels.cols, h = levels.rows, map_step = w + 2;
   cv::Mat padded;
   cv::copyMakeBorder(levels, padded, 1, 1, 1, 1, cv::BORDER_REPLICATE);
-  // The edge map with a border of kNotEdge; magnitudes of rows y - 1, y, y + 1, with
-  // zero rows above and below the image.
+  // The edge map with a border of kNotEdge. Blocks of rows are suppressed in parallel
+  // (each writes only its own rows); hysteresis then follows edges across them.
   std::vector<uint8_t> map(static_cast<size_t>(map_step) * (h + 2), kNotEdge);
-  std::vector<int16_t> mags(3 * static_cast<size_t>(map_step), 0);
-  std::vector<int16_t> grads(4 * static_cast<size_t>(w));
-  int16_t* mag[3] = {&mags[0], &mags[map_step], &mags[2 * map_step]};  // prev, cur, next
-  int16_t* dx[2] = {&grads[0], &grads[2 * w]};                         // cur, next
-  int16_t* dy[2] = {&grads[w], &grads[3 * w]};
+  constexpr int kBlockRows = 32;
+  const int blocks = (h + kBlockRows - 1) / kBlockRows;
+  std::vector<std::vector<uint8_t*>> strong(blocks);
+  default_pool().parallel_for(blocks, 1, [&](int64_t first, int64_t last) {
+    for (int64_t b = first; b < last; ++b)
+      suppress_rows(padded, low, high, static_cast<int>(b) * kBlockRows,
+                    std::min(h, static_cast<int>(b + 1) * kBlockRows), map.data(), strong[b]);
+  });
   std::vector<uint8_t*> stack;
-  gradient_row(padded, 0, dx[1], dy[1], mag[2]);
-  for (int y = 0; y < h; ++y) {
-    std::swap(mag[0], mag[1]);
-    std::swap(mag[1], mag[2]);
-    std::swap(dx[0], dx[1]);
-    std::swap(dy[0], dy[1]);
-    if (y + 1 < h)
-      gradient_row(padded, y + 1, dx[1], dy[1], mag[2]);
-    else
-      std::fill(mag[2], mag[2] + map_step, 0);
-    if (y == 0) std::fill(mag[0], mag[0] + map_step, 0);
-    uint8_t* row = &map[static_cast<size_t>(y + 1) * map_step + 1];
-    for (int x = 0; x < w; ++x) {
-      const int m = mag[1][x + 1];
-      if (m <= low || !local_max(m, dx[0][x], dy[0][x], mag[0], mag[1], mag[2], x + 1)) continue;
-      row[x] = m > high ? kEdge : kCandidate;
-      if (m > high) stack.push_back(row + x);
-    }
-  }
+  for (const auto& s : strong) stack.insert(stack.end(), s.begin(), s.end());
   // Hysteresis: candidates 8-connected to an edge become edges.
   const std::ptrdiff_t neighbours[8] = {-map_step - 1, -map_step, -map_step + 1, -1, 1,
                                         map_step - 1,  map_step,  map_step + 1};

@@ -1,9 +1,11 @@
 #include "slicing/level_stats.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
 #include "engine/isa.h"
+#include "engine/thread_pool.h"
 #include "slicing/adaptive.h"
 #include "slicing/row_kernels.h"
 
@@ -33,40 +35,62 @@ cv::Mat normalize_to_levels(const cv::Mat& disparity, cv::Mat* values) {
   return levels;
 }
 
-NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
-  const Normalization n = normalization_of(disparity);
-  const slicing::NormalizeRowFn normalize_row = slicing::slicing_kernels(active_isa()).normalize_row;
-  // Four tables, pixel x counted in table x % 4, as in level_histogram: neighbours,
-  // which mostly share a level, then update different counters instead of waiting. A
-  // level's count and sum sit side by side, and each table is padded off a 4 KiB
-  // multiple so that no two tables' counters alias in the CPU's store forwarding.
-  constexpr int kTables = 4, kPaddedLevels = kDisparityLevels + 4;
-  struct Accumulator {
-    long long count = 0;
-    double sum = 0;
-  };
-  std::vector<Accumulator> tables(kTables * kPaddedLevels);
-  Accumulator* table[kTables] = {&tables[0], &tables[kPaddedLevels], &tables[2 * kPaddedLevels],
-                                 &tables[3 * kPaddedLevels]};
+namespace {
+
+// A level's count and sum side by side.
+struct Accumulator {
+  long long count = 0;
+  double sum = 0;
+};
+
+// Counts and sums the levels of rows [begin, end) (normalising them on the way) into
+// `tables`: four tables, pixel x counted in table x % 4, as in level_histogram:
+// neighbours, which mostly share a level, then update different counters instead of
+// waiting. Each table is padded off a 4 KiB multiple so that no two tables' counters
+// alias in the CPU's store forwarding.
+constexpr int kTables = 4, kPaddedLevels = kDisparityLevels + 4;
+
+void gather_rows(const cv::Mat& disparity, const Normalization& n, slicing::NormalizeRowFn normalize_row,
+                 int begin, int end, cv::Mat& levels, Accumulator* tables) {
+  Accumulator* table[kTables] = {tables, tables + kPaddedLevels, tables + 2 * kPaddedLevels,
+                                 tables + 3 * kPaddedLevels};
   auto add = [&](int t, uchar l, float value) {
     ++table[t][l].count;
     table[t][l].sum += value;
   };
-  NormalizedLevels out{cv::Mat(disparity.size(), CV_8UC1), {}};
   std::vector<float> values(disparity.cols);
-  for (int y = 0; y < disparity.rows; ++y) {
-    uchar* level = out.levels.ptr<uchar>(y);
+  for (int y = begin; y < end; ++y) {
+    uchar* level = levels.ptr<uchar>(y);
     normalize_row(disparity.ptr<float>(y), disparity.cols, n.lo, n.scale, values.data(), level);
     int x = 0;
     for (; x + kTables <= disparity.cols; x += kTables)
       for (int k = 0; k < kTables; ++k) add(k, level[x + k], values[x + k]);
     for (; x < disparity.cols; ++x) add(0, level[x], values[x]);
   }
+}
+
+}  // namespace
+
+NormalizedLevels normalize_with_stats(const cv::Mat& disparity) {
+  const Normalization n = normalization_of(disparity);
+  const slicing::NormalizeRowFn normalize_row = slicing::slicing_kernels(active_isa()).normalize_row;
+  // Blocks of rows in parallel, each into its own tables, added up in block order: the
+  // sums do not depend on the thread count.
+  constexpr int kBlockRows = 32;
+  const int blocks = (disparity.rows + kBlockRows - 1) / kBlockRows;
+  std::vector<Accumulator> tables(static_cast<size_t>(blocks) * kTables * kPaddedLevels);
+  NormalizedLevels out{cv::Mat(disparity.size(), CV_8UC1), {}};
+  default_pool().parallel_for(blocks, 1, [&](int64_t first, int64_t last) {
+    for (int64_t b = first; b < last; ++b)
+      gather_rows(disparity, n, normalize_row, static_cast<int>(b) * kBlockRows,
+                  std::min(disparity.rows, static_cast<int>(b + 1) * kBlockRows), out.levels,
+                  &tables[static_cast<size_t>(b) * kTables * kPaddedLevels]);
+  });
   out.stats = {std::vector<long long>(kDisparityLevels, 0), std::vector<double>(kDisparityLevels, 0.0)};
-  for (int k = 0; k < kTables; ++k)
+  for (int t = 0; t < blocks * kTables; ++t)
     for (int l = 0; l < kDisparityLevels; ++l) {
-      out.stats.count[l] += table[k][l].count;
-      out.stats.sum[l] += table[k][l].sum;
+      out.stats.count[l] += tables[static_cast<size_t>(t) * kPaddedLevels + l].count;
+      out.stats.sum[l] += tables[static_cast<size_t>(t) * kPaddedLevels + l].sum;
     }
   return out;
 }
