@@ -43,13 +43,13 @@ struct Accumulator {
   double sum = 0;
 };
 
-// Counts and sums the levels of rows [begin, end) (normalising them on the way) into
-// `tables`: four tables, pixel x counted in table x % 4, as in level_histogram:
-// neighbours, which mostly share a level, then update different counters instead of
-// waiting. Each table is padded off a 4 KiB multiple so that no two tables' counters
-// alias in the CPU's store forwarding.
+// Four tables per block of rows, each padded off a 4 KiB multiple so that no two tables'
+// counters alias in the CPU's store forwarding.
 constexpr int kTables = 4, kPaddedLevels = kDisparityLevels + 4;
 
+// Counts and sums the levels of rows [begin, end) (normalising them on the way) into
+// `tables`, pixel x in table x % 4, as in level_histogram: neighbours, which mostly share
+// a level, then update different counters instead of waiting on one.
 void gather_rows(const cv::Mat& disparity, const Normalization& n, slicing::NormalizeRowFn normalize_row,
                  int begin, int end, cv::Mat& levels, Accumulator* tables) {
   Accumulator* table[kTables] = {tables, tables + kPaddedLevels, tables + 2 * kPaddedLevels,
