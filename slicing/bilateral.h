@@ -1,9 +1,8 @@
 // The slicer's bilateral filter on 8-bit disparity levels: OpenCV's cv::bilateralFilter
 // for CV_8UC1 (the same disk of taps, Gaussian space and colour weights, reflect-101
 // border), computed by our row kernels (slicing/row_kernels.h) over the thread
-// pool. OpenCV's own was the slicer's largest cost at the depth network's working size
-// (246 us at 256x192; ours 124 us on AVX-512, one thread), where the whole slicing step
-// may take 5% of the network's time.
+// pool. OpenCV's own was the slicer's largest cost at the depth network's working size,
+// where the whole slicing step may take 5% of the network's time (`ampi bench pipeline`).
 #pragma once
 #include <opencv2/core.hpp>
 

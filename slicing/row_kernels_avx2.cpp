@@ -1,42 +1,16 @@
 // AVX2 + FMA variants of the slicer's row kernels (see row_kernels.h): 8 pixels at a
-// time; the bilateral weights are powers of two computed in registers.
-//
-// As in render/composite_avx2.cpp, the ISA is enabled with a target pragma after the
-// standard headers, so no inline function those headers define is compiled for AVX2.
+// time; the bilateral weights are powers of two computed in registers
+// (exp2_nonpositive, kernels/x86/avx2_math.h).
+#include <immintrin.h>
+
 #include <cstdint>
 #include <cstring>
 
+#include "kernels/x86/avx2_math.h"
 #include "slicing/row_kernels.h"
-
-#if defined(__x86_64__)
-#include <immintrin.h>
-
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2,fma"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2,fma")
-#endif
 
 namespace ampi::slicing::avx2 {
 namespace {
-
-// 2^y for y <= 0 (below -126 it returns 2^-126, a weight no sum notices): 2^n times a
-// degree-6 Taylor polynomial of 2^f on f in [-0.5, 0.5], relative error about 1e-7.
-inline __m256 exp2_nonpositive(__m256 y) {
-  y = _mm256_max_ps(y, _mm256_set1_ps(-126.0f));
-  const __m256 n = _mm256_round_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m256 f = _mm256_sub_ps(y, n);
-  __m256 p = _mm256_set1_ps(1.540353039e-4f);
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(1.333355815e-3f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(9.618129108e-3f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(5.550410866e-2f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(2.402265070e-1f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(6.931471806e-1f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(1.0f));
-  const __m256i e = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
-  return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
-}
 
 inline __m256 load8(const uint8_t* p) {
   return _mm256_cvtepi32_ps(_mm256_cvtepu8_epi32(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p))));
@@ -132,7 +106,7 @@ void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, flo
     for (int h = 0; h < pairs.count; ++h) {
       const __m256 d = _mm256_sub_ps(load_levels(p + x + pairs.offset[h], count), v0);
       const __m256 y = _mm256_fmadd_ps(_mm256_mul_ps(d, d), coeff, _mm256_set1_ps(pairs.log2_space_weight[h]));
-      store_floats(weight[h] + x, exp2_nonpositive(y), count);
+      store_floats(weight[h] + x, ampi::avx2::exp2_nonpositive(y), count);
     }
   }
 }
@@ -152,10 +126,3 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
 }
 
 }  // namespace ampi::slicing::avx2
-
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
-#endif  // __x86_64__

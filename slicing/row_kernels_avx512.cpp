@@ -1,40 +1,15 @@
 // AVX-512 variants of the slicer's row kernels (see row_kernels.h): 16 pixels at a
 // time, the row's tail under a lane mask.
-#include <cstdint>
-
-#include "slicing/row_kernels.h"
-
-#if defined(__x86_64__)
 #include <immintrin.h>
 
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx512f,avx512bw,avx512vl,fma"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx512f,avx512bw,avx512vl,fma")
-// GCC 12 warns falsely inside its own intrinsics (masked loads, 256-bit extracts), as
-// cmake/isa.cmake notes.
-#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
-#pragma GCC diagnostic ignored "-Wuninitialized"
-#endif
+#include <algorithm>
+#include <cstdint>
+
+#include "kernels/x86/avx512_math.h"
+#include "slicing/row_kernels.h"
 
 namespace ampi::slicing::avx512 {
 namespace {
-
-// 2^y for y <= 0, as in the AVX2 variant; scalef applies 2^n.
-inline __m512 exp2_nonpositive(__m512 y) {
-  y = _mm512_max_ps(y, _mm512_set1_ps(-126.0f));
-  const __m512 n = _mm512_roundscale_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m512 f = _mm512_sub_ps(y, n);
-  __m512 p = _mm512_set1_ps(1.540353039e-4f);
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(1.333355815e-3f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(9.618129108e-3f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(5.550410866e-2f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(2.402265070e-1f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(6.931471806e-1f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(1.0f));
-  return _mm512_scalef_ps(p, n);
-}
 
 inline __m512 load16(const uint8_t* p, __mmask16 lanes) {
   return _mm512_cvtepi32_ps(_mm512_cvtepu8_epi32(_mm_maskz_loadu_epi8(lanes, p)));
@@ -65,23 +40,23 @@ void range_row(const float* in, int n, ValueRange& range) {
     lo = _mm512_min_ps(lo, v);
     hi = _mm512_max_ps(hi, v);
   }
-  range.lo = _mm512_reduce_min_ps(lo);
-  range.hi = _mm512_reduce_max_ps(hi);
+  // Lane by lane: GCC 12's _mm512_reduce_min_ps warns falsely inside its own header.
+  alignas(64) float los[16], his[16];
+  _mm512_store_ps(los, lo);
+  _mm512_store_ps(his, hi);
+  range.lo = *std::min_element(los, los + 16);
+  range.hi = *std::max_element(his, his + 16);
   range.finite = range.finite && finite == 0xFFFF;
 }
 
 void normalize_row(const float* in, int n, double lo, double scale, float* value, uint8_t* level) {
   const __m512d lo8 = _mm512_set1_pd(lo), scale8 = _mm512_set1_pd(scale);
-  for (int x = 0; x < n; x += 16) {
-    const __mmask16 lanes = lanes_left(n - x);
+  for (int x = 0; x < n; x += 8) {  // 8 doubles a vector
+    const __mmask8 lanes = static_cast<__mmask8>(lanes_left(n - x));
     // Masked-off lanes read lo: 0, defined, never stored.
-    const __m512 x16 = _mm512_mask_loadu_ps(_mm512_set1_ps(static_cast<float>(lo)), lanes, in + x);
-    const __m256 low = normalize8(_mm512_castps512_ps256(x16), lo8, scale8);
-    const __m256 high = normalize8(_mm256_castpd_ps(_mm512_extractf64x4_pd(_mm512_castps_pd(x16), 1)), lo8, scale8);
-    const __m512 v = _mm512_castpd_ps(_mm512_insertf64x4(_mm512_castps_pd(_mm512_castps256_ps512(low)),
-                                                         _mm256_castps_pd(high), 1));
-    _mm512_mask_storeu_ps(value + x, lanes, v);
-    _mm_mask_storeu_epi8(level + x, lanes, _mm512_cvtusepi32_epi8(_mm512_cvtps_epi32(v)));  // ties to even
+    const __m256 v = normalize8(_mm256_mask_loadu_ps(_mm256_set1_ps(static_cast<float>(lo)), lanes, in + x), lo8, scale8);
+    _mm256_mask_storeu_ps(value + x, lanes, v);
+    _mm_mask_storeu_epi8(level + x, lanes, _mm256_cvtusepi32_epi8(_mm256_cvtps_epi32(v)));  // ties to even
   }
 }
 
@@ -93,7 +68,7 @@ void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, flo
     for (int h = 0; h < pairs.count; ++h) {
       const __m512 d = _mm512_sub_ps(load16(p + x + pairs.offset[h], lanes), v0);
       const __m512 y = _mm512_fmadd_ps(_mm512_mul_ps(d, d), coeff, _mm512_set1_ps(pairs.log2_space_weight[h]));
-      _mm512_mask_storeu_ps(weight[h] + x, lanes, exp2_nonpositive(y));
+      _mm512_mask_storeu_ps(weight[h] + x, lanes, ampi::avx512::exp2_nonpositive(y));
     }
   }
 }
@@ -114,10 +89,3 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
 }
 
 }  // namespace ampi::slicing::avx512
-
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
-#endif  // __x86_64__

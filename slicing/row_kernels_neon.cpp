@@ -1,31 +1,14 @@
 // NEON variants of the slicer's row kernels (see row_kernels.h): 8 pixels at a time as
-// two 4-float halves; the bilateral weights are powers of two computed in registers.
+// two 4-float halves; the bilateral weights are computed in registers as powers of two
+// (exp2_nonpositive).
 #include <cstdint>
 #include <cstring>
 
+#include "kernels/arm/neon_math.h"
 #include "slicing/row_kernels.h"
-
-#if defined(__aarch64__)
-#include <arm_neon.h>
 
 namespace ampi::slicing::neon {
 namespace {
-
-// 2^y for y <= 0, as in the x86 variants.
-inline float32x4_t exp2_nonpositive(float32x4_t y) {
-  y = vmaxq_f32(y, vdupq_n_f32(-126.0f));
-  const float32x4_t n = vrndnq_f32(y);
-  const float32x4_t f = vsubq_f32(y, n);
-  float32x4_t p = vdupq_n_f32(1.540353039e-4f);
-  p = vfmaq_f32(vdupq_n_f32(1.333355815e-3f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(9.618129108e-3f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(5.550410866e-2f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(2.402265070e-1f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(6.931471806e-1f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(1.0f), p, f);
-  const int32x4_t e = vshlq_n_s32(vaddq_s32(vcvtq_s32_f32(n), vdupq_n_s32(127)), 23);
-  return vmulq_f32(p, vreinterpretq_f32_s32(e));
-}
 
 struct Floats8 {
   float32x4_t lo, hi;
@@ -106,7 +89,7 @@ void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, flo
   const float32x4_t coeff = vdupq_n_f32(pairs.color_log2_coeff);
   auto weigh = [&](float32x4_t v, float32x4_t v0, float32x4_t log2_space) {
     const float32x4_t d = vsubq_f32(v, v0);
-    return exp2_nonpositive(vfmaq_f32(log2_space, vmulq_f32(d, d), coeff));
+    return ampi::neon::exp2_nonpositive(vfmaq_f32(log2_space, vmulq_f32(d, d), coeff));
   };
   for (int x = 0; x < n; x += 8) {
     const int count = n - x < 8 ? n - x : 8;
@@ -141,4 +124,3 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
 }
 
 }  // namespace ampi::slicing::neon
-#endif  // __aarch64__

@@ -23,6 +23,22 @@ inline float32x4_t exp(float32x4_t x) {
   return vmulq_f32(p, vreinterpretq_f32_s32(e));
 }
 
+// 2^y for y <= 0, as in the x86 headers.
+inline float32x4_t exp2_nonpositive(float32x4_t y) {
+  y = vmaxq_f32(y, vdupq_n_f32(-126.0f));
+  const float32x4_t n = vrndnq_f32(y);
+  const float32x4_t f = vsubq_f32(y, n);
+  float32x4_t p = vdupq_n_f32(1.540353039e-4f);
+  p = vfmaq_f32(vdupq_n_f32(1.333355815e-3f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(9.618129108e-3f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(5.550410866e-2f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(2.402265070e-1f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(6.931471806e-1f), p, f);
+  p = vfmaq_f32(vdupq_n_f32(1.0f), p, f);
+  const int32x4_t e = vshlq_n_s32(vaddq_s32(vcvtq_s32_f32(n), vdupq_n_s32(127)), 23);
+  return vmulq_f32(p, vreinterpretq_f32_s32(e));
+}
+
 inline float32x4_t sigmoid(float32x4_t x) {
   const float32x4_t one = vdupq_n_f32(1.0f);
   return vdivq_f32(one, vaddq_f32(one, exp(vnegq_f32(x))));

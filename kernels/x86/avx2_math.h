@@ -25,6 +25,25 @@ inline __m256 exp(__m256 x) {
   return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
 }
 
+// 2^y for y <= 0 (below -126 it returns 2^-126): 2^n times a degree-6 Taylor polynomial
+// of 2^f on f in [-0.5, 0.5], relative error about 1e-7. Cheaper than exp (no clamp from
+// above, no two-part range reduction): the slicer's bilateral weights, where it is
+// the inner loop, use it.
+inline __m256 exp2_nonpositive(__m256 y) {
+  y = _mm256_max_ps(y, _mm256_set1_ps(-126.0f));
+  const __m256 n = _mm256_round_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
+  const __m256 f = _mm256_sub_ps(y, n);
+  __m256 p = _mm256_set1_ps(1.540353039e-4f);
+  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(1.333355815e-3f));
+  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(9.618129108e-3f));
+  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(5.550410866e-2f));
+  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(2.402265070e-1f));
+  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(6.931471806e-1f));
+  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(1.0f));
+  const __m256i e = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
+  return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
+}
+
 inline __m256 sigmoid(__m256 x) {
   const __m256 one = _mm256_set1_ps(1.0f);
   return _mm256_div_ps(one, _mm256_add_ps(one, exp(_mm256_sub_ps(_mm256_setzero_ps(), x))));
