@@ -23,6 +23,13 @@ constexpr int kMaxDepthwiseKernelH = 16;
 constexpr int kGemmTilesPerIm2colTile = 8;
 // Pointwise path: gemm tiles per parallel_for grain, enough to amortise the scheduling.
 constexpr int64_t kPointwiseGrainTiles = 4;
+// Taps path: convolutions with at most this many outputs (one NEON vector).
+constexpr int kTapsMaxOutputs = 4;
+// Taps path: row bands per thread, so uneven bands even out; each band computes the
+// kernel's extra rows above and below it again, so bands are at least this many times
+// taller than that.
+constexpr int kTapsBandsPerThread = 4;
+constexpr int kTapsMinBandSeams = 4;
 
 // Outputs (depthwise and pointwise) larger than this many last-level caches go out with
 // streaming stores (DepthwiseRowArgs::stream_out, GemmArgs::stream_c). Outputs that may
@@ -84,16 +91,10 @@ Conv2d::Path choose_path(const ConvParams& p) {
     return Conv2d::Path::Pointwise;
   if (p.groups == p.in_c && p.in_c == p.out_c && p.kernel_h <= kMaxDepthwiseKernelH)
     return Conv2d::Path::Depthwise;
+  if (p.groups == 1 && p.out_c <= kTapsMaxOutputs && p.stride_h == 1 && p.stride_w == 1 &&
+      p.kernel_h * p.kernel_w > 1)
+    return Conv2d::Path::Taps;
   return Conv2d::Path::General;
-}
-
-// Output columns whose kernel_w taps all fall inside the input row:
-// x*stride - pad_left >= 0 and x*stride - pad_left + (kernel_w-1)*dilation <= in_w - 1.
-void interior_columns(const ConvParams& p, int in_w, int out_w, int& begin, int& end) {
-  begin = std::min(out_w, (p.pad_left + p.stride_w - 1) / p.stride_w);
-  const int last_start = in_w - 1 - (p.kernel_w - 1) * p.dilation_w + p.pad_left;
-  end = last_start < 0 ? 0 : std::min(out_w, last_start / p.stride_w + 1);
-  end = std::max(begin, end);
 }
 
 // Gathers the receptive fields of output pixels [first, first + count) for one group:
@@ -116,6 +117,26 @@ void im2col(const ConvParams& p, const float* in, int in_h, int in_w, int out_w,
       }
     }
   }
+}
+
+// out[x][j] += tap[(x + shift) * stride + j] for x in [x0, x1), j < c: one tap's
+// contributions (a row of the taps path's ring) added to an output row, with the channel
+// count a constant for the compiler.
+template <int kChannels>
+void add_tap_fixed(const float* tap, int64_t stride, int shift, int x0, int x1, float* out) {
+  for (int x = x0; x < x1; ++x)
+    for (int j = 0; j < kChannels; ++j) out[x * kChannels + j] += tap[(x + shift) * stride + j];
+}
+
+void add_tap(const float* tap, int64_t stride, int shift, int c, int x0, int x1, float* out) {
+  switch (c) {
+    case 1: return add_tap_fixed<1>(tap, stride, shift, x0, x1, out);
+    case 2: return add_tap_fixed<2>(tap, stride, shift, x0, x1, out);
+    case 3: return add_tap_fixed<3>(tap, stride, shift, x0, x1, out);
+    case 4: return add_tap_fixed<4>(tap, stride, shift, x0, x1, out);
+  }
+  for (int x = x0; x < x1; ++x)
+    for (int j = 0; j < c; ++j) out[x * c + j] += tap[(x + shift) * stride + j];
 }
 
 // The general path's per-thread im2col buffer. It grows to the largest tile a convolution
@@ -158,6 +179,15 @@ void validate(const ConvParams& p) {
     fail("groups " + std::to_string(p.groups) + " does not divide out_c " + std::to_string(p.out_c));
 }
 
+// Output columns whose kernel_w taps all fall inside the input row:
+// x*stride - pad_left >= 0 and x*stride - pad_left + (kernel_w-1)*dilation <= in_w - 1.
+void depthwise_interior_columns(const ConvParams& p, int in_w, int out_w, int& begin, int& end) {
+  begin = std::min(out_w, (p.pad_left + p.stride_w - 1) / p.stride_w);
+  const int last_start = in_w - 1 - (p.kernel_w - 1) * p.dilation_w + p.pad_left;
+  end = last_start < 0 ? 0 : std::min(out_w, last_start / p.stride_w + 1);
+  end = std::max(begin, end);
+}
+
 int64_t gemm_packed_size(int n, int k, int nr) {
   const int64_t panels = (n + nr - 1) / nr;
   return panels * (1 + static_cast<int64_t>(k)) * nr;
@@ -189,6 +219,21 @@ Conv2d::Conv2d(const ConvParams& p, const float* weights, const float* bias, con
     packed_ = packed;
     return;
   }
+  if (path_ == Path::Taps) {
+    // Weights regrouped [tap][out_c][in_c]: gemm column tap * out_c + j is output j's tap.
+    const int n = taps * p.out_c;
+    std::vector<float> by_tap(static_cast<size_t>(n) * p.in_c);
+    for (int j = 0; j < p.out_c; ++j)
+      for (int t = 0; t < taps; ++t)
+        std::copy_n(weights + (static_cast<int64_t>(j) * taps + t) * p.in_c, p.in_c,
+                    by_tap.begin() + (static_cast<int64_t>(t) * p.out_c + j) * p.in_c);
+    group_stride_ = gemm_packed_size(n, p.in_c, k.gemm_nr);
+    std::shared_ptr<float> packed = allocate_floats(group_stride_ + p.out_c);
+    pack_gemm_weights(by_tap.data(), nullptr, n, p.in_c, k.gemm_nr, packed.get());
+    for (int j = 0; j < p.out_c; ++j) packed.get()[group_stride_ + j] = bias ? bias[j] : 0.0f;
+    packed_ = packed;
+    return;
+  }
   const int cout_g = p.out_c / p.groups;
   const int kdim = taps * (p.in_c / p.groups);
   group_stride_ = gemm_packed_size(cout_g, kdim, k.gemm_nr);
@@ -213,6 +258,7 @@ void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* r
       run_pointwise(in, static_cast<int64_t>(in_h) * in_w, out, residual, pool);
       break;
     case Path::Depthwise: run_depthwise(in, in_h, in_w, out, residual, pool); break;
+    case Path::Taps: run_taps(in, in_h, in_w, out, residual, pool); break;
     case Path::General: run_general(in, in_h, in_w, out, residual, pool); break;
   }
 }
@@ -258,7 +304,7 @@ void Conv2d::run_depthwise(const float* in, int in_h, int in_w, float* out, cons
   base.dilation_w = p_.dilation_w;
   base.pad_left = p_.pad_left;
   base.out_w = out_w;
-  interior_columns(p_, in_w, out_w, base.interior_begin, base.interior_end);
+  depthwise_interior_columns(p_, in_w, out_w, base.interior_begin, base.interior_end);
   base.weights = packed_.get();
   base.bias = packed_.get() + static_cast<int64_t>(p_.kernel_h) * p_.kernel_w * c;
   base.act = p_.act;
@@ -278,6 +324,58 @@ void Conv2d::run_depthwise(const float* in, int in_h, int in_w, float* out, cons
       a.out = out + y * row_floats;
       a.residual = residual ? residual + y * row_floats : nullptr;
       k_->depthwise_row(a);
+    }
+  });
+}
+
+void Conv2d::run_taps(const float* in, int in_h, int in_w, float* out, const float* residual,
+                      ThreadPool& pool) const {
+  const int out_h = p_.out_h(in_h), out_w = p_.out_w(in_w), out_c = p_.out_c;
+  const int taps = p_.kernel_h * p_.kernel_w, columns = taps * out_c;
+  const int span = (p_.kernel_h - 1) * p_.dilation_h + 1;  // input rows one output row reads
+  const int64_t row_floats = static_cast<int64_t>(in_w) * columns;
+  const float* bias = packed_.get() + group_stride_;
+  GemmArgs base;
+  base.n = columns;
+  base.k = p_.in_c;
+  base.a_stride = p_.in_c;
+  base.packed = packed_.get();
+  base.c_stride = columns;
+  const int bands = std::clamp(std::min(kTapsBandsPerThread * pool.size(), out_h / (kTapsMinBandSeams * span)), 1, out_h);
+  const int band_h = (out_h + bands - 1) / bands;
+  pool.parallel_for(bands, 1, [&](int64_t first, int64_t last) {
+    // A ring of span rows of tap contributions: input row iy lives in slot iy % span.
+    float* ring = im2col_scratch(static_cast<size_t>(span * row_floats));
+    GemmArgs g = base;
+    for (int64_t band = first; band < last; ++band) {
+      const int y0 = static_cast<int>(band) * band_h, y1 = std::min(out_h, y0 + band_h);
+      int next_row = std::max(0, y0 - p_.pad_top);  // the first input row not yet in the ring
+      for (int y = y0; y < y1; ++y) {
+        const int top = y - p_.pad_top;
+        for (const int end = std::min(in_h, top + span); next_row < end; ++next_row)
+          for (int x = 0; x < in_w; x += k_->gemm_mr) {
+            g.m = std::min(k_->gemm_mr, in_w - x);
+            g.a = in + (static_cast<int64_t>(next_row) * in_w + x) * p_.in_c;
+            g.c = ring + (next_row % span) * row_floats + static_cast<int64_t>(x) * columns;
+            k_->gemm(g);
+          }
+        float* row_out = out + static_cast<int64_t>(y) * out_w * out_c;
+        for (int x = 0; x < out_w; ++x) std::copy_n(bias, out_c, row_out + static_cast<int64_t>(x) * out_c);
+        for (int ky = 0; ky < p_.kernel_h; ++ky) {
+          const int iy = top + ky * p_.dilation_h;
+          if (iy < 0 || iy >= in_h) continue;
+          for (int kx = 0; kx < p_.kernel_w; ++kx) {
+            // Output columns whose tap reads inside the row: x - pad_left + kx*dilation in [0, in_w).
+            const int shift = kx * p_.dilation_w - p_.pad_left;
+            const int x0 = std::max(0, -shift), x1 = std::min(out_w, in_w - shift);
+            const float* tap = ring + (iy % span) * row_floats + (ky * p_.kernel_w + kx) * out_c;
+            add_tap(tap, columns, shift, out_c, x0, x1, row_out);
+          }
+        }
+        const int64_t row_values = static_cast<int64_t>(out_w) * out_c;
+        k_->activate(row_out, row_values, p_.act);
+        if (residual) k_->add(row_out, residual + static_cast<int64_t>(y) * row_values, row_values, {}, row_out);
+      }
     }
   });
 }

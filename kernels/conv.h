@@ -10,9 +10,14 @@
 //              matrix (pixels x in_c); the table's gemm tile runs on it directly.
 //   depthwise  groups == in_c == out_c: the table's depthwise_row kernel, one output row
 //              per call, vectorised across channels.
+//   taps       a k x k convolution with at most 4 outputs, stride 1, groups 1 (a head
+//              that predicts a few channels): im2col's gemm would fill a quarter of an
+//              AVX-512 tile's lanes or less. Instead one gemm over each input row gives
+//              every tap's contribution (kernel_h*kernel_w*out_c columns), and each output
+//              pixel adds its taps' contributions from the rows and columns they read.
 //   general    anything else: per pixel tile and group, im2col into a per-thread scratch
 //              buffer, then the same gemm tile.
-// Threads split the output pixels (pointwise, general) or output rows (depthwise); every
+// Threads split the output pixels (pointwise, general) or output rows (depthwise, taps); every
 // output value is computed by the same code in the same order whatever the thread count,
 // so results are bitwise identical across thread counts.
 #pragma once
@@ -48,11 +53,14 @@ void validate(const ConvParams& p);
 // Writes ceil(n / nr) panels of (1 + k) * nr floats: the panel's bias, then for each kk
 // the nr weights b[j][kk]; columns past n are zero. Returns the floats written.
 int64_t gemm_packed_size(int n, int k, int nr);
+// Output columns [begin, end) of a depthwise row whose kernel_w taps all fall inside an
+// input row of in_w pixels (DepthwiseRowArgs::interior_begin and interior_end).
+void depthwise_interior_columns(const ConvParams& p, int in_w, int out_w, int& begin, int& end);
 void pack_gemm_weights(const float* b, const float* bias, int n, int k, int nr, float* packed);
 
 class Conv2d {
  public:
-  enum class Path { Pointwise, Depthwise, General };
+  enum class Path { Pointwise, Depthwise, Taps, General };
 
   Conv2d() = default;
   // weights OHWI [out_c][kernel_h][kernel_w][in_c/groups]; bias [out_c] or nullptr.
@@ -62,6 +70,12 @@ class Conv2d {
 
   const ConvParams& params() const { return p_; }
   Path path() const { return path_; }
+  // For ops that call the micro-kernels themselves (kernels/inverted_residual.h): the
+  // table the weights were packed for, and the packed weights (pointwise and general: one
+  // pack_gemm_weights block per group; depthwise: [kernel_h][kernel_w][channels] weights,
+  // then [channels] bias).
+  const KernelTable& table() const { return *k_; }
+  const float* packed() const { return packed_.get(); }
 
   // in: NHWC [in_h][in_w][in_c]; out: [out_h][out_w][out_c];
   // out = act(conv(in) + bias) + residual   (residual: nullptr or the shape of out)
@@ -75,6 +89,8 @@ class Conv2d {
                      ThreadPool& pool) const;
   void run_depthwise(const float* in, int in_h, int in_w, float* out, const float* residual,
                      ThreadPool& pool) const;
+  void run_taps(const float* in, int in_h, int in_w, float* out, const float* residual,
+                ThreadPool& pool) const;
   void run_general(const float* in, int in_h, int in_w, float* out, const float* residual,
                    ThreadPool& pool) const;
 
@@ -84,6 +100,8 @@ class Conv2d {
   // Packed weights, immutable after construction (shared by copies of this Conv2d).
   // Pointwise/general: one pack_gemm_weights block per group, group_stride_ floats apart.
   // Depthwise: [kernel_h][kernel_w][channels] weights, then [channels] bias.
+  // Taps: one pack_gemm_weights block without bias (column tap * out_c + j holds output
+  // j's weights of one tap), group_stride_ floats, then [out_c] bias.
   std::shared_ptr<const float> packed_;
   int64_t group_stride_ = 0;
 };

@@ -3,10 +3,12 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <optional>
 #include <stdexcept>
 
 #include "engine/arena.h"
 #include "kernels/conv.h"
+#include "kernels/inverted_residual.h"
 #include "kernels/ops.h"
 #include "weights_format/weight_file.h"
 
@@ -28,13 +30,15 @@ struct BlockSpec {
 };
 
 // One block with its weights packed. A plain block uses `conv` only; a MobileNetV3 block
-// uses expand (absent when expanded == in_c), dw, se (when se_reduced > 0) and project.
+// uses expand (absent when expanded == in_c), dw, se (when se_reduced > 0) and project;
+// without squeeze-excite the three convolutions run as one op (`fused`).
 struct Block {
   BlockSpec spec;
   int in_c = 0;
   Conv2d conv, expand, dw, project;
   bool has_expand = false, has_se = false, residual = false;
   SqueezeExcite se;
+  std::optional<InvertedResidual> fused;
 };
 
 using Stage = std::vector<Block>;
@@ -115,6 +119,8 @@ Block load_block(const WeightFile& f, const std::string& prefix, const BlockSpec
   }
   b.project = load_conv(f, prefix + ".project", s.expanded, s.out_c, 1, 1, Activation::None, table, params);
   b.residual = in_c == s.out_c;
+  if (!b.has_se)
+    b.fused.emplace(b.has_expand ? std::optional<Conv2d>(b.expand) : std::nullopt, b.dw, b.project);
   return b;
 }
 
@@ -267,6 +273,14 @@ int DepthNet::Impl::add_block(Plan& p, const Block& b, int x, int h, int w) cons
     const int y = p.produce(h, w, b.spec.out_c);
     p.consume(x);
     p.push([&b, x, y, h, w](Plan& pl, ThreadPool& pool) { b.conv.run(pl.data(x), h, w, pl.data(y), nullptr, pool); });
+    return y;
+  }
+  if (b.fused) {
+    const int y = p.produce(h, w, b.spec.out_c);
+    p.consume(x);
+    p.push([&b, x, y, h, w](Plan& pl, ThreadPool& pool) {
+      b.fused->run(pl.data(x), h, w, pl.data(y), b.residual ? pl.data(x) : nullptr, pool);
+    });
     return y;
   }
   int t = x;

@@ -24,7 +24,10 @@ std::vector<ConvCase> one_case_per_path(uint32_t seed) {
   general.p.in_c = 5;
   general.p.out_c = 19;
   general.p.groups = 1;
-  std::vector<ConvCase> cases = {pointwise, depthwise, general};
+  ConvCase taps = general;
+  taps.p.in_c = 24;
+  taps.p.out_c = 4;
+  std::vector<ConvCase> cases = {pointwise, depthwise, general, taps};
   for (ConvCase& c : cases) c.seed = seed++;
   return cases;
 }
@@ -72,6 +75,16 @@ TEST_CASE("Conv2d picks the path by shape") {
   CHECK(path_of(cases[0].p) == Conv2d::Path::Pointwise);
   CHECK(path_of(cases[1].p) == Conv2d::Path::Depthwise);
   CHECK(path_of(cases[2].p) == Conv2d::Path::General);
+  CHECK(path_of(cases[3].p) == Conv2d::Path::Taps);
+  ConvParams five_outputs = cases[3].p;
+  five_outputs.out_c = 5;
+  CHECK(path_of(five_outputs) == Conv2d::Path::General);
+  ConvParams strided_taps = cases[3].p;
+  strided_taps.stride_h = 2;
+  CHECK(path_of(strided_taps) == Conv2d::Path::General);
+  ConvParams grouped_taps = cases[3].p;
+  grouped_taps.groups = 2;
+  CHECK(path_of(grouped_taps) == Conv2d::Path::General);
   ConvParams strided = cases[0].p;
   strided.stride_w = 2;
   CHECK(path_of(strided) == Conv2d::Path::General);

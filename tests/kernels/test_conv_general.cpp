@@ -1,4 +1,5 @@
-// General convolution (im2col + GEMM): every kernel size, stride, padding, dilation and
+// General convolution (im2col + GEMM) and the taps path of few-output convolutions
+// (Conv2d::Path::Taps, chosen by shape): every kernel size, stride, padding, dilation and
 // group count the networks use, every runnable ISA against the direct reference.
 #include "test_conv_util.h"
 
@@ -100,4 +101,22 @@ TEST_CASE("general conv matches the reference for grouped and rectangular layers
     set_padding(mixed, 2, 4, 1, 0);
     check_all_isas(mixed, pool);
   }
+}
+
+TEST_CASE("few-output conv (the taps path) matches the reference: channels, kernels, paddings, dilations") {
+  ThreadPool pool(2);
+  uint32_t seed = 9500;
+  for (int out_c = 1; out_c <= 4; ++out_c)
+    for (int in_c : sweep<int>({1, 3, 8, 16, 17, 33}, {3, 17}))
+      for (int kernel : sweep<int>({3, 5}, {3}))
+        for (int dilation : sweep<int>({1, 2}, {2})) {
+          const int reach = (kernel - 1) * dilation;
+          for (int pad_top : {0, reach / 2, reach}) {
+            // Tall enough for several bands of rows on two threads.
+            ConvCase c = general(in_c, out_c, kernel, 1, dilation, 1, sweep<int>({41}, {13}).front(), 11, seed++);
+            set_padding(c, pad_top, reach - pad_top, reach / 2, reach / 2 + 1);
+            c.p.kernel_w = kernel == 3 ? 5 : 3;
+            if (fits(c)) check_all_isas(c, pool);
+          }
+        }
 }

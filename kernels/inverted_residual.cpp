@@ -1,0 +1,158 @@
+#include "kernels/inverted_residual.h"
+
+#include <algorithm>
+#include <array>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace ampi {
+namespace {
+
+// What one task keeps in cache: the ring of expanded rows and the depthwise row. Half of a
+// 512 KiB L2 (the smallest per-core L2 of the x86 and ARM cores ampi targets is larger
+// still on most), so the input rows and the packed weights fit beside it.
+constexpr int64_t kTileCacheBytes = 256 * 1024;
+// Tiles per thread: enough that uneven tiles (the last band and strip are shorter) even
+// out between threads.
+constexpr int kTilesPerThread = 8;
+// Bands at least this many times as tall as the rows their seams compute twice.
+constexpr int kMinBandSeams = 8;
+// Depthwise kernels taller than this take the separate steps (Conv2d::run handles them).
+constexpr int kMaxKernelH = 16;
+
+[[noreturn]] void reject(const std::string& why) {
+  throw std::invalid_argument("InvertedResidual: " + why);
+}
+
+void check_chain(const std::optional<Conv2d>& expand, const Conv2d& dw, const Conv2d& project) {
+  const ConvParams& d = dw.params();
+  if (dw.path() != Conv2d::Path::Depthwise) reject("the middle convolution is not depthwise");
+  if (d.stride_h != 1 || d.stride_w != 1) reject("the depthwise stride is not 1");
+  if (d.pad_top + d.pad_bottom != (d.kernel_h - 1) * d.dilation_h ||
+      d.pad_left + d.pad_right != (d.kernel_w - 1) * d.dilation_w)
+    reject("the depthwise padding does not keep the size");
+  if (d.kernel_h > kMaxKernelH) reject("the depthwise kernel is taller than 16");
+  if (project.path() != Conv2d::Path::Pointwise) reject("the projection is not pointwise");
+  if (project.params().in_c != d.in_c) reject("the projection does not read the depthwise output");
+  if (&project.table() != &dw.table()) reject("the convolutions are packed for different tables");
+  if (!expand) return;
+  if (expand->path() != Conv2d::Path::Pointwise) reject("the expansion is not pointwise");
+  if (expand->params().out_c != d.in_c) reject("the depthwise does not read the expansion");
+  if (&expand->table() != &dw.table()) reject("the convolutions are packed for different tables");
+}
+
+// Rows [first, first + m) of a pointwise convolution through the table's gemm tile: a holds
+// `pixels` rows of k floats, c receives them with n floats each; the same calls, on the same
+// rows, as Conv2d::run_pointwise makes.
+void pointwise_rows(const Conv2d& conv, const float* a, int64_t pixels, float* c, const float* residual) {
+  const KernelTable& k = conv.table();
+  GemmArgs g;
+  g.n = conv.params().out_c;
+  g.k = conv.params().in_c;
+  g.a_stride = g.k;
+  g.packed = conv.packed();
+  g.c_stride = g.n;
+  g.act = conv.params().act;
+  for (int64_t row = 0; row < pixels; row += k.gemm_mr) {
+    g.m = static_cast<int>(std::min<int64_t>(k.gemm_mr, pixels - row));
+    g.a = a + row * g.k;
+    g.c = c + row * g.n;
+    g.residual = residual ? residual + row * g.n : nullptr;
+    k.gemm(g);
+  }
+}
+
+}  // namespace
+
+struct InvertedResidual::Scratch {
+  std::vector<float> ring, dw_row;
+};
+
+InvertedResidual::InvertedResidual(std::optional<Conv2d> expand, Conv2d dw, Conv2d project)
+    : expand_(std::move(expand)), dw_(std::move(dw)), project_(std::move(project)) {
+  check_chain(expand_, dw_, project_);
+  expanded_ = dw_.params().in_c;
+  in_c_ = expand_ ? expand_->params().in_c : expanded_;
+  out_c_ = project_.params().out_c;
+}
+
+void InvertedResidual::run(const float* in, int h, int w, float* out, const float* residual,
+                           ThreadPool& pool) const {
+  if (h <= 0 || w <= 0) throw std::invalid_argument("InvertedResidual: empty input");
+  const ConvParams& d = dw_.params();
+  const int span = (d.kernel_h - 1) * d.dilation_h + 1;  // input rows one output row reads
+  const int halo = (d.kernel_w - 1) * d.dilation_w;      // extra input columns of a strip
+  // Strips as wide as the cache allows for the ring (span rows) plus the depthwise row.
+  const int64_t pixel_bytes = int64_t(expanded_) * sizeof(float);
+  const int fit = int(std::max<int64_t>(8, kTileCacheBytes / ((span + 1) * pixel_bytes) - halo));
+  const int strips = (w + fit - 1) / fit;
+  const int strip_w = (w + strips - 1) / strips;
+  const int wanted_bands = (kTilesPerThread * pool.size() + strips - 1) / strips;
+  const int bands = std::clamp(std::min(wanted_bands, h / std::max(1, kMinBandSeams * (span - 1))), 1, h);
+  const int band_h = (h + bands - 1) / bands;
+  const int ring_w = std::min(w, strip_w + halo);
+  pool.parallel_for(int64_t(bands) * strips, 1, [&](int64_t first, int64_t last) {
+    thread_local Scratch scratch;
+    for (int64_t i = first; i < last; ++i) {
+      const int band = int(i / strips), strip = int(i % strips);
+      const Tile t{band * band_h, std::min(h, (band + 1) * band_h), strip * strip_w,
+                   std::min(w, (strip + 1) * strip_w)};
+      if (t.y0 < t.y1 && t.x0 < t.x1) run_tile(t, in, h, w, out, residual, ring_w, scratch);
+    }
+  });
+}
+
+void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, float* out,
+                                const float* residual, int ring_w, Scratch& s) const {
+  const ConvParams& d = dw_.params();
+  const int span = (d.kernel_h - 1) * d.dilation_h + 1;
+  // The input columns the strip reads, and the depthwise arguments for a row of them: the
+  // strip's first output column reads column x0 - pad_left + kx * dilation.
+  const int cx0 = std::max(0, t.x0 - d.pad_left);
+  const int cx1 = std::min(w, t.x1 - 1 - d.pad_left + (d.kernel_w - 1) * d.dilation_w + 1);
+  const int cols = cx1 - cx0, out_w = t.x1 - t.x0;
+  ConvParams local = d;
+  local.pad_left = cx0 - t.x0 + d.pad_left;
+  DepthwiseRowArgs a;
+  a.in_w = cols;
+  a.channels = expanded_;
+  a.kernel_h = d.kernel_h;
+  a.kernel_w = d.kernel_w;
+  a.dilation_w = d.dilation_w;
+  a.pad_left = local.pad_left;
+  a.out_w = out_w;
+  depthwise_interior_columns(local, cols, out_w, a.interior_begin, a.interior_end);
+  a.weights = dw_.packed();
+  a.bias = dw_.packed() + int64_t(d.kernel_h) * d.kernel_w * expanded_;
+  a.act = d.act;
+
+  const int64_t ring_row = int64_t(ring_w) * expanded_;
+  if (expand_ && s.ring.size() < size_t(span * ring_row)) s.ring.resize(size_t(span * ring_row));
+  if (s.dw_row.size() < size_t(out_w) * expanded_) s.dw_row.resize(size_t(out_w) * expanded_);
+  // Input row r's columns [cx0, cx1) after the expansion: a ring slot, filled on first use.
+  const auto expanded_row = [&](int r) -> const float* {
+    if (!expand_) return in + (int64_t(r) * w + cx0) * in_c_;
+    return s.ring.data() + (r % span) * ring_row;
+  };
+  int next_row = std::max(0, t.y0 - d.pad_top);  // the first row not yet expanded
+  std::array<const float*, kMaxKernelH> rows;
+  a.in_rows = rows.data();
+  for (int y = t.y0; y < t.y1; ++y) {
+    const int top = y - d.pad_top;
+    for (const int last = std::min(h, top + span); expand_ && next_row < last; ++next_row)
+      pointwise_rows(*expand_, in + (int64_t(next_row) * w + cx0) * in_c_, cols,
+                     s.ring.data() + (next_row % span) * ring_row, nullptr);
+    for (int ky = 0; ky < d.kernel_h; ++ky) {
+      const int iy = top + ky * d.dilation_h;
+      rows[ky] = iy >= 0 && iy < h ? expanded_row(iy) : nullptr;
+    }
+    a.out = s.dw_row.data();
+    dw_.table().depthwise_row(a);
+    const int64_t first = int64_t(y) * w + t.x0;
+    pointwise_rows(project_, s.dw_row.data(), out_w, out + first * out_c_,
+                   residual ? residual + first * out_c_ : nullptr);
+  }
+}
+
+}  // namespace ampi
