@@ -104,16 +104,28 @@ void im2col(const ConvParams& p, const float* in, int in_h, int in_w, int out_w,
             int64_t first, int count, float* cols) {
   const int cin_g = p.in_c / p.groups;
   const size_t tap_bytes = static_cast<size_t>(cin_g) * sizeof(float);
+  // With one group and no dilation across the row, a kernel row's taps are one contiguous
+  // run of the input row: one copy instead of kernel_w.
+  const bool whole_runs = p.groups == 1 && p.dilation_w == 1;
   for (int i = 0; i < count; ++i) {
     const int oy = static_cast<int>((first + i) / out_w), ox = static_cast<int>((first + i) % out_w);
+    const int ix0 = ox * p.stride_w - p.pad_left;
+    const bool row_inside = whole_runs && ix0 >= 0 && ix0 + p.kernel_w <= in_w;
     for (int ky = 0; ky < p.kernel_h; ++ky) {
       const int iy = oy * p.stride_h - p.pad_top + ky * p.dilation_h;
+      const bool iy_inside = iy >= 0 && iy < in_h;
+      const float* in_row = iy_inside ? in + static_cast<int64_t>(iy) * in_w * p.in_c : nullptr;
+      if (row_inside && iy_inside) {
+        std::memcpy(cols, in_row + static_cast<int64_t>(ix0) * p.in_c, p.kernel_w * tap_bytes);
+        cols += p.kernel_w * cin_g;
+        continue;
+      }
       for (int kx = 0; kx < p.kernel_w; ++kx, cols += cin_g) {
-        const int ix = ox * p.stride_w - p.pad_left + kx * p.dilation_w;
-        if (iy < 0 || iy >= in_h || ix < 0 || ix >= in_w)
+        const int ix = ix0 + kx * p.dilation_w;
+        if (!iy_inside || ix < 0 || ix >= in_w)
           std::memset(cols, 0, tap_bytes);
         else
-          std::memcpy(cols, in + (static_cast<int64_t>(iy) * in_w + ix) * p.in_c + group * cin_g, tap_bytes);
+          std::memcpy(cols, in_row + static_cast<int64_t>(ix) * p.in_c + group * cin_g, tap_bytes);
       }
     }
   }

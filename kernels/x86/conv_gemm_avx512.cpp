@@ -1,6 +1,7 @@
 // AVX-512 GEMM tile, 12 rows x 32 columns (two vectors): 24 accumulators, 2 weight
 // vectors and one broadcast in the 32 zmm registers; the broadcast folds into the FMA's
-// memory operand. A panel whose last columns fit in one vector runs a 12x16 tile.
+// memory operand. A panel whose last columns fit in 24, 16 or 8 lanes runs a 12x24,
+// 12x16 or 12x8 tile.
 // Column tails use masked loads and stores, so no lane outside the output is touched.
 // Outputs larger than the last-level cache go out with streaming stores (stream_c):
 // 1x1 16->64 at 512x384 (12 MB in, 50 MB out): 4.8 -> 3.2 ms on 1 thread, 2.4 -> 1.6 ms
@@ -35,26 +36,38 @@ inline void stream_columns(__m512 v, float* c, const float* residual) {
   _mm512_stream_ps(c, v);
 }
 
-// Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel;
-// columns <= 16 * kVectors, == 16 * kVectors when kStream.
-template <int kVectors, bool kStream>
+// Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel: kFull
+// 16-lane vectors, then (kHalf) one 8-lane vector for a panel whose last columns fit in
+// 8. The half vector is a 256-bit FMA, which on cores that split 512-bit FMAs in two
+// (AMD Zen 4) costs half a full one, and on others no more. columns <= 16 * kFull + 8 *
+// kHalf, == 16 * kFull when kStream.
+template <int kFull, bool kHalf, bool kStream>
 void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
+  static_assert(!(kHalf && kStream), "streamed outputs are whole 16-lane lines");
+  constexpr int kVectors = kFull + (kHalf ? 1 : 0);
   const int m = g.m, k = g.k;
   // Rows past m re-read row m-1 (their results are dropped): no branches in the k loop.
   const float* a[kGemmMr];
   for (int r = 0; r < kGemmMr; ++r) a[r] = g.a + std::min(r, m - 1) * g.a_stride;
-  __m512 acc[kGemmMr][kVectors];
-  for (int v = 0; v < kVectors; ++v) {
+  __m512 acc[kGemmMr][kFull > 0 ? kFull : 1];
+  __m256 half[kGemmMr];
+  for (int v = 0; v < kFull; ++v) {
     const __m512 bias = _mm512_loadu_ps(panel + 16 * v);
     for (int r = 0; r < kGemmMr; ++r) acc[r][v] = bias;
   }
+  if constexpr (kHalf) {
+    const __m256 bias = _mm256_loadu_ps(panel + 16 * kFull);
+    for (int r = 0; r < kGemmMr; ++r) half[r] = bias;
+  }
   const float* b = panel + kGemmNr;
   for (int kk = 0; kk < k; ++kk, b += kGemmNr) {
-    __m512 bv[kVectors];
-    for (int v = 0; v < kVectors; ++v) bv[v] = _mm512_loadu_ps(b + 16 * v);
+    __m512 bv[kFull > 0 ? kFull : 1];
+    for (int v = 0; v < kFull; ++v) bv[v] = _mm512_loadu_ps(b + 16 * v);
+    __m256 bh = kHalf ? _mm256_loadu_ps(b + 16 * kFull) : _mm256_setzero_ps();
     for (int r = 0; r < kGemmMr; ++r) {
       const __m512 av = _mm512_set1_ps(a[r][kk]);
-      for (int v = 0; v < kVectors; ++v) acc[r][v] = _mm512_fmadd_ps(av, bv[v], acc[r][v]);
+      for (int v = 0; v < kFull; ++v) acc[r][v] = _mm512_fmadd_ps(av, bv[v], acc[r][v]);
+      if constexpr (kHalf) half[r] = _mm256_fmadd_ps(_mm512_castps512_ps256(av), bh, half[r]);
     }
   }
   // Unrolled, so every acc index is a constant and the accumulators live in registers
@@ -62,14 +75,17 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
 #pragma GCC unroll 16
   for (int r = 0; r < kGemmMr; ++r) {
     if (r >= m) continue;
-    activate_tile(acc[r], g.act, [](__m512 x, ActivationSpec a) { return activate(x, a); });
+    __m512 out[kVectors];
+    for (int v = 0; v < kFull; ++v) out[v] = acc[r][v];
+    if constexpr (kHalf) out[kFull] = _mm512_zextps256_ps512(half[r]);
+    activate_tile(out, g.act, [](__m512 x, ActivationSpec a) { return activate(x, a); });
     float* c = g.c + r * g.c_stride + j0;
     const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
     for (int v = 0; v < kVectors; ++v) {
       if constexpr (kStream)
-        stream_columns(acc[r][v], c + 16 * v, res ? res + 16 * v : nullptr);
+        stream_columns(out[v], c + 16 * v, res ? res + 16 * v : nullptr);
       else
-        store_columns(acc[r][v], c + 16 * v, res ? res + 16 * v : nullptr, columns - 16 * v);
+        store_columns(out[v], c + 16 * v, res ? res + 16 * v : nullptr, columns - 16 * v);
     }
   }
 }
@@ -80,10 +96,16 @@ void panels(const GemmArgs& g) {
   const float* panel = g.packed;
   for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats) {
     const int columns = std::min(kGemmNr, g.n - j0);
-    if (columns > 16)
-      panel_tile<2, kStream>(g, panel, j0, columns);
+    if (columns > 24)
+      panel_tile<2, false, kStream>(g, panel, j0, columns);
+    else if constexpr (kStream)  // whole lines: 16 columns
+      panel_tile<1, false, true>(g, panel, j0, columns);
+    else if (columns > 16)
+      panel_tile<1, true, false>(g, panel, j0, columns);
+    else if (columns > 8)
+      panel_tile<1, false, false>(g, panel, j0, columns);
     else
-      panel_tile<1, kStream>(g, panel, j0, columns);
+      panel_tile<0, true, false>(g, panel, j0, columns);
   }
 }
 
