@@ -267,7 +267,7 @@ void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* r
          std::to_string(p_.kernel_w) + " kernel");
   switch (path_) {
     case Path::Pointwise:
-      run_pointwise(in, static_cast<int64_t>(in_h) * in_w, out, residual, pool);
+      run_pointwise(packed_.get(), in, static_cast<int64_t>(in_h) * in_w, out, residual, pool);
       break;
     case Path::Depthwise: run_depthwise(in, in_h, in_w, out, residual, pool); break;
     case Path::Taps: run_taps(in, in_h, in_w, out, residual, pool); break;
@@ -275,14 +275,36 @@ void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* r
   }
 }
 
-void Conv2d::run_pointwise(const float* in, int64_t pixels, float* out, const float* residual,
-                           ThreadPool& pool) const {
+void Conv2d::run_scaled_input(const float* in, int in_h, int in_w, const float* in_scale,
+                              float* out, const float* residual, ThreadPool& pool) const {
+  if (!k_) fail("run_scaled_input() on an empty Conv2d");
+  if (path_ != Path::Pointwise) fail("run_scaled_input() needs a pointwise convolution");
+  if (in_h <= 0 || in_w <= 0)
+    fail("input size " + std::to_string(in_h) + "x" + std::to_string(in_w) + " is empty");
+  // Each panel is [bias: nr][k][nr]: row kk of every panel takes the scale of input kk.
+  const int nr = k_->gemm_nr, kdim = p_.in_c;
+  const int64_t size = gemm_packed_size(p_.out_c, kdim, nr);
+  AlignedBuffer scaled_buffer = aligned_alloc64(static_cast<size_t>(size) * sizeof(float));
+  float* scaled = static_cast<float*>(scaled_buffer.get());
+  const float* packed = packed_.get();
+  for (int64_t panel = 0; panel < size; panel += static_cast<int64_t>(1 + kdim) * nr) {
+    std::copy_n(packed + panel, nr, scaled + panel);
+    for (int kk = 0; kk < kdim; ++kk) {
+      const int64_t row = panel + static_cast<int64_t>(1 + kk) * nr;
+      for (int j = 0; j < nr; ++j) scaled[row + j] = packed[row + j] * in_scale[kk];
+    }
+  }
+  run_pointwise(scaled, in, static_cast<int64_t>(in_h) * in_w, out, residual, pool);
+}
+
+void Conv2d::run_pointwise(const float* packed, const float* in, int64_t pixels, float* out,
+                           const float* residual, ThreadPool& pool) const {
   const int mr = k_->gemm_mr;
   GemmArgs base;
   base.n = p_.out_c;
   base.k = p_.in_c;
   base.a_stride = p_.in_c;
-  base.packed = packed_.get();
+  base.packed = packed;
   base.c_stride = p_.out_c;
   base.act = p_.act;
   base.stream_c = stream_output(out, pixels * p_.out_c, p_.out_c);

@@ -83,10 +83,15 @@ class Conv2d {
   // empty Conv2d or an input too small for the dilated kernel.
   void run(const float* in, int in_h, int in_w, float* out, const float* residual = nullptr,
            ThreadPool& pool = default_pool()) const;
+  // A pointwise convolution of the input with input channel j multiplied by in_scale[j]
+  // (a squeeze-excite gate, SqueezeExcite::gate): the scale goes into a copy of the packed
+  // weights, so the input is read once, as it is. Throws std::runtime_error on other paths.
+  void run_scaled_input(const float* in, int in_h, int in_w, const float* in_scale, float* out,
+                        const float* residual = nullptr, ThreadPool& pool = default_pool()) const;
 
  private:
-  void run_pointwise(const float* in, int64_t pixels, float* out, const float* residual,
-                     ThreadPool& pool) const;
+  void run_pointwise(const float* packed, const float* in, int64_t pixels, float* out,
+                     const float* residual, ThreadPool& pool) const;
   void run_depthwise(const float* in, int in_h, int in_w, float* out, const float* residual,
                      ThreadPool& pool) const;
   void run_taps(const float* in, int in_h, int in_w, float* out, const float* residual,

@@ -73,6 +73,14 @@ SqueezeExcite::SqueezeExcite(int channels, int reduced, const float* w1, const f
 }
 
 void SqueezeExcite::run(const float* in, int h, int w, float* out, ThreadPool& pool) const {
+  const std::vector<float> scale = gate(in, h, w, pool);
+  const int c = channels_;
+  pool.parallel_for(static_cast<int64_t>(h) * w, chunk_grain(2 * c), [&](int64_t begin, int64_t end) {
+    k_->channel_scale(in + begin * c, end - begin, c, scale.data(), out + begin * c);
+  });
+}
+
+std::vector<float> SqueezeExcite::gate(const float* in, int h, int w, ThreadPool& pool) const {
   require(k_ != nullptr, "SqueezeExcite", "run on a default-constructed instance");
   require_map("SqueezeExcite", h, w, channels_);
   const int c = channels_;
@@ -93,9 +101,7 @@ void SqueezeExcite::run(const float* in, int h, int w, float* out, ThreadPool& p
             {Activation::ReLU}, hidden.data());
   k_->dense(w2_.data(), b2_.empty() ? nullptr : b2_.data(), c, reduced_, hidden.data(),
             {Activation::HardSigmoid}, gate.data());
-  pool.parallel_for(static_cast<int64_t>(h) * w, chunk_grain(2 * c), [&](int64_t begin, int64_t end) {
-    k_->channel_scale(in + begin * c, end - begin, c, gate.data(), out + begin * c);
-  });
+  return gate;
 }
 
 void haar_dwt(const float* in, int h, int w, int c, float* out, ThreadPool& pool,

@@ -45,6 +45,10 @@ class SqueezeExcite {
   SqueezeExcite(int channels, int reduced, const float* w1, const float* b1, const float* w2,
                 const float* b2, const KernelTable& k = kernels());
   void run(const float* in, int h, int w, float* out, ThreadPool& pool = default_pool()) const;
+  // The per-channel scale run() multiplies `in` by: a consumer that is linear in its input
+  // (a 1x1 convolution, Conv2d::run_scaled_input) can fold it into its weights instead of
+  // making a pass over the whole map.
+  std::vector<float> gate(const float* in, int h, int w, ThreadPool& pool = default_pool()) const;
 
   int channels() const { return channels_; }
   int reduced() const { return reduced_; }

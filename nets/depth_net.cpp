@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 
@@ -119,7 +120,7 @@ Block load_block(const WeightFile& f, const std::string& prefix, const BlockSpec
   }
   b.project = load_conv(f, prefix + ".project", s.expanded, s.out_c, 1, 1, Activation::None, table, params);
   b.residual = in_c == s.out_c;
-  if (!b.has_se)
+  if (!b.has_se)  // with squeeze-excite the projection waits for the whole depthwise output
     b.fused.emplace(b.has_expand ? std::optional<Conv2d>(b.expand) : std::nullopt, b.dw, b.project);
   return b;
 }
@@ -294,16 +295,17 @@ int DepthNet::Impl::add_block(Plan& p, const Block& b, int x, int h, int w) cons
   p.consume(t);
   p.push([&b, t, d, h, w](Plan& pl, ThreadPool& pool) { b.dw.run(pl.data(t), h, w, pl.data(d), nullptr, pool); });
   t = d;
-  if (b.has_se) {  // in place: the gate scales the depthwise output where it lies
-    p.consume(t);
-    p.push([&b, t, h, w](Plan& pl, ThreadPool& pool) { b.se.run(pl.data(t), h, w, pl.data(t), pool); });
-  }
+  // Only blocks with squeeze-excite get here (the others are fused). Its gate scales the
+  // depthwise output's channels, which the projection folds into its weights.
+  auto gate = std::make_shared<std::vector<float>>();
+  p.consume(t);
+  p.push([&b, t, h, w, gate](Plan& pl, ThreadPool& pool) { *gate = b.se.gate(pl.data(t), h, w, pool); });
   const int y = p.produce(h, w, b.spec.out_c);
   p.consume(t);
   if (b.residual) p.consume(x);
   const bool residual = b.residual;
-  p.push([&b, t, x, y, h, w, residual](Plan& pl, ThreadPool& pool) {
-    b.project.run(pl.data(t), h, w, pl.data(y), residual ? pl.data(x) : nullptr, pool);
+  p.push([&b, t, x, y, h, w, residual, gate](Plan& pl, ThreadPool& pool) {
+    b.project.run_scaled_input(pl.data(t), h, w, gate->data(), pl.data(y), residual ? pl.data(x) : nullptr, pool);
   });
   return y;
 }

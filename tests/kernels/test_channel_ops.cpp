@@ -197,6 +197,12 @@ TEST_CASE("SqueezeExcite: every ISA matches the definition, the same bits for an
           if (first.empty()) first.assign(got.data(), got.data() + in.size());
           CHECK(test::max_abs_diff(first.data(), got.data(), in.size()) == 0.0f);
         }
+        // The gate is what run() multiplies by (Conv2d::run_scaled_input folds it instead).
+        const std::vector<float> gate = se.gate(in.data(), size.h, size.w, *test::thread_pools()[1]);
+        REQUIRE(gate.size() == size_t(c));
+        bool gate_is_the_scale = true;
+        for (int64_t i = 0; i < pixels * c; ++i) gate_is_the_scale &= first[i] == in[i] * gate[i % c];
+        CHECK(gate_is_the_scale);
         std::vector<float> in_place = in;  // out may alias in
         se.run(in_place.data(), size.h, size.w, in_place.data(), *test::thread_pools()[1]);
         CHECK(test::max_abs_diff(first.data(), in_place.data(), in.size()) == 0.0f);

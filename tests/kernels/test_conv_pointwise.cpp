@@ -89,3 +89,36 @@ TEST_CASE("gemm tiles with streaming stores match plain stores and the reference
       check_streaming_all_isas(c, run_gemm_tiles);
     }
 }
+
+TEST_CASE("pointwise conv with a scaled input equals the conv of the scaled input") {
+  ThreadPool pool(2);
+  uint32_t seed = 3500;
+  for (int in_c : sweep<int>({1, 7, 16, 33, 96}, {7, 33}))
+    for (int out_c : sweep<int>({4, 24, 40, 64}, {24, 40})) {
+      ConvCase c = pointwise(in_c, out_c, 5, 7, seed);
+      c.p.act = {Activation::HardSwish};
+      c.residual = true;
+      ConvData d(c);
+      const std::vector<float> scale = random_floats(in_c, seed++, 0.0f, 1.0f);
+      ConvData scaled = d;
+      for (size_t i = 0; i < scaled.in.size(); ++i) scaled.in[i] *= scale[i % in_c];
+      const Expected e = expected_output(c, scaled);
+      for (Isa isa : runnable_isas()) {
+        INFO(describe(c) << ", isa " << isa_name(isa));
+        const Conv2d conv(c.p, d.weights.data(), d.bias.data(), kernels_for(isa));
+        std::vector<float> out(e.out.size() + kGuardFloats, kGuardValue);
+        std::fill(out.begin(), out.begin() + e.out.size(), NAN);
+        conv.run_scaled_input(d.in.data(), c.in_h, c.in_w, scale.data(), out.data(), d.residual.data(), pool);
+        CHECK(std::all_of(out.begin() + e.out.size(), out.end(), [](float v) { return v == kGuardValue; }));
+        const float err = max_abs_diff(e.out.data(), out.data(), e.out.size());
+        INFO("max error " << err << ", scale " << e.scale);
+        REQUIRE(err <= kRelativeTolerance * e.scale);
+      }
+    }
+  ConvCase general = pointwise(4, 4, 5, 5, seed);
+  general.p.kernel_h = general.p.kernel_w = 3;
+  const ConvData d(general);
+  const Conv2d conv(general.p, d.weights.data(), d.bias.data());
+  std::vector<float> out(5 * 5 * 4), scale(4, 1.0f);
+  CHECK_THROWS_AS(conv.run_scaled_input(d.in.data(), 5, 5, scale.data(), out.data()), std::runtime_error);
+}
