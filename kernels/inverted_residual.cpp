@@ -10,8 +10,7 @@ namespace ampi {
 namespace {
 
 // What one task keeps in cache: the ring of expanded rows and the depthwise row. Half of a
-// 512 KiB L2 (the smallest per-core L2 of the x86 and ARM cores ampi targets is larger
-// still on most), so the input rows and the packed weights fit beside it.
+// 512 KiB L2, so the input rows and the packed weights fit beside it.
 constexpr int64_t kTileCacheBytes = 256 * 1024;
 // Tiles per thread: enough that uneven tiles (the last band and strip are shorter) even
 // out between threads.
@@ -42,9 +41,9 @@ void check_chain(const std::optional<Conv2d>& expand, const Conv2d& dw, const Co
   if (&expand->table() != &dw.table()) reject("the convolutions are packed for different tables");
 }
 
-// Rows [first, first + m) of a pointwise convolution through the table's gemm tile: a holds
-// `pixels` rows of k floats, c receives them with n floats each; the same calls, on the same
-// rows, as Conv2d::run_pointwise makes.
+// A pointwise convolution of `pixels` contiguous pixels through the table's gemm tile: a
+// holds in_c floats per pixel, c receives out_c. A tile's rows do not interact, so each
+// pixel gets the bits Conv2d::run_pointwise gives it, wherever the tiles start.
 void pointwise_rows(const Conv2d& conv, const float* a, int64_t pixels, float* c, const float* residual) {
   const KernelTable& k = conv.table();
   GemmArgs g;
