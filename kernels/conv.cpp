@@ -97,6 +97,15 @@ Conv2d::Path choose_path(const ConvParams& p) {
   return Conv2d::Path::General;
 }
 
+// Output columns whose kernel_w taps all fall inside the input row:
+// x*stride - pad_left >= 0 and x*stride - pad_left + (kernel_w-1)*dilation <= in_w - 1.
+void interior_columns(const ConvParams& p, int in_w, int out_w, int& begin, int& end) {
+  begin = std::min(out_w, (p.pad_left + p.stride_w - 1) / p.stride_w);
+  const int last_start = in_w - 1 - (p.kernel_w - 1) * p.dilation_w + p.pad_left;
+  end = last_start < 0 ? 0 : std::min(out_w, last_start / p.stride_w + 1);
+  end = std::max(begin, end);
+}
+
 // Gathers the receptive fields of output pixels [first, first + count) for one group:
 // row i holds the kernel_h x kernel_w x in_c/groups inputs of pixel first + i in OHWI
 // order, so it lines up with a packed filter; taps in the padding are zeros.
@@ -191,15 +200,6 @@ void validate(const ConvParams& p) {
     fail("groups " + std::to_string(p.groups) + " does not divide out_c " + std::to_string(p.out_c));
 }
 
-// Output columns whose kernel_w taps all fall inside the input row:
-// x*stride - pad_left >= 0 and x*stride - pad_left + (kernel_w-1)*dilation <= in_w - 1.
-void depthwise_interior_columns(const ConvParams& p, int in_w, int out_w, int& begin, int& end) {
-  begin = std::min(out_w, (p.pad_left + p.stride_w - 1) / p.stride_w);
-  const int last_start = in_w - 1 - (p.kernel_w - 1) * p.dilation_w + p.pad_left;
-  end = last_start < 0 ? 0 : std::min(out_w, last_start / p.stride_w + 1);
-  end = std::max(begin, end);
-}
-
 int64_t gemm_packed_size(int n, int k, int nr) {
   const int64_t panels = (n + nr - 1) / nr;
   return panels * (1 + static_cast<int64_t>(k)) * nr;
@@ -256,15 +256,19 @@ Conv2d::Conv2d(const ConvParams& p, const float* weights, const float* bias, con
   packed_ = packed;
 }
 
-void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* residual,
-                 ThreadPool& pool) const {
-  if (!k_) fail("run() on an empty Conv2d");
+void Conv2d::check_input(const char* method, int in_h, int in_w) const {
+  if (!k_) fail(std::string(method) + "() on an empty Conv2d");
   if (in_h <= 0 || in_w <= 0)
     fail("input size " + std::to_string(in_h) + "x" + std::to_string(in_w) + " is empty");
   if (p_.out_h(in_h) <= 0 || p_.out_w(in_w) <= 0)
     fail("input " + std::to_string(in_h) + "x" + std::to_string(in_w) +
          " is smaller than the dilated " + std::to_string(p_.kernel_h) + "x" +
          std::to_string(p_.kernel_w) + " kernel");
+}
+
+void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* residual,
+                 ThreadPool& pool) const {
+  check_input("run", in_h, in_w);
   switch (path_) {
     case Path::Pointwise:
       run_pointwise(packed_.get(), in, static_cast<int64_t>(in_h) * in_w, out, residual, pool);
@@ -277,10 +281,8 @@ void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* r
 
 void Conv2d::run_scaled_input(const float* in, int in_h, int in_w, const float* in_scale,
                               float* out, const float* residual, ThreadPool& pool) const {
-  if (!k_) fail("run_scaled_input() on an empty Conv2d");
+  check_input("run_scaled_input", in_h, in_w);
   if (path_ != Path::Pointwise) fail("run_scaled_input() needs a pointwise convolution");
-  if (in_h <= 0 || in_w <= 0)
-    fail("input size " + std::to_string(in_h) + "x" + std::to_string(in_w) + " is empty");
   // Each panel is [bias: nr][k][nr]: row kk of every panel takes the scale of input kk.
   const int nr = k_->gemm_nr, kdim = p_.in_c;
   const int64_t size = gemm_packed_size(p_.out_c, kdim, nr);
@@ -297,16 +299,41 @@ void Conv2d::run_scaled_input(const float* in, int in_h, int in_w, const float* 
   run_pointwise(scaled, in, static_cast<int64_t>(in_h) * in_w, out, residual, pool);
 }
 
+GemmArgs Conv2d::pointwise_gemm_args() const {
+  GemmArgs g;
+  g.n = p_.out_c;
+  g.k = p_.in_c;
+  g.a_stride = p_.in_c;
+  g.packed = packed_.get();
+  g.c_stride = p_.out_c;
+  g.act = p_.act;
+  return g;
+}
+
+DepthwiseRowArgs Conv2d::depthwise_row_args(int in_w, int out_w, int pad_left) const {
+  DepthwiseRowArgs a;
+  a.in_w = in_w;
+  a.channels = p_.in_c;
+  a.kernel_h = p_.kernel_h;
+  a.kernel_w = p_.kernel_w;
+  a.stride_w = p_.stride_w;
+  a.dilation_w = p_.dilation_w;
+  a.pad_left = pad_left;
+  a.out_w = out_w;
+  ConvParams shifted = p_;
+  shifted.pad_left = pad_left;
+  interior_columns(shifted, in_w, out_w, a.interior_begin, a.interior_end);
+  a.weights = packed_.get();
+  a.bias = packed_.get() + static_cast<int64_t>(p_.kernel_h) * p_.kernel_w * p_.in_c;
+  a.act = p_.act;
+  return a;
+}
+
 void Conv2d::run_pointwise(const float* packed, const float* in, int64_t pixels, float* out,
                            const float* residual, ThreadPool& pool) const {
   const int mr = k_->gemm_mr;
-  GemmArgs base;
-  base.n = p_.out_c;
-  base.k = p_.in_c;
-  base.a_stride = p_.in_c;
+  GemmArgs base = pointwise_gemm_args();
   base.packed = packed;
-  base.c_stride = p_.out_c;
-  base.act = p_.act;
   base.stream_c = stream_output(out, pixels * p_.out_c, p_.out_c);
   const int64_t tiles = (pixels + mr - 1) / mr;
   pool.parallel_for(tiles, kPointwiseGrainTiles, [&](int64_t first, int64_t last) {
@@ -329,19 +356,7 @@ void Conv2d::run_pointwise(const float* packed, const float* in, int64_t pixels,
 void Conv2d::run_depthwise(const float* in, int in_h, int in_w, float* out, const float* residual,
                            ThreadPool& pool) const {
   const int out_h = p_.out_h(in_h), out_w = p_.out_w(in_w), c = p_.in_c;
-  DepthwiseRowArgs base;
-  base.in_w = in_w;
-  base.channels = c;
-  base.kernel_h = p_.kernel_h;
-  base.kernel_w = p_.kernel_w;
-  base.stride_w = p_.stride_w;
-  base.dilation_w = p_.dilation_w;
-  base.pad_left = p_.pad_left;
-  base.out_w = out_w;
-  depthwise_interior_columns(p_, in_w, out_w, base.interior_begin, base.interior_end);
-  base.weights = packed_.get();
-  base.bias = packed_.get() + static_cast<int64_t>(p_.kernel_h) * p_.kernel_w * c;
-  base.act = p_.act;
+  DepthwiseRowArgs base = depthwise_row_args(in_w, out_w, p_.pad_left);
   const int64_t row_floats = static_cast<int64_t>(out_w) * c;
   base.stream_out = stream_output(out, row_floats * out_h, c);
   pool.parallel_for(out_h, 1, [&](int64_t first, int64_t last) {

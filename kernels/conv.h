@@ -53,9 +53,6 @@ void validate(const ConvParams& p);
 // Writes ceil(n / nr) panels of (1 + k) * nr floats: the panel's bias, then for each kk
 // the nr weights b[j][kk]; columns past n are zero. Returns the floats written.
 int64_t gemm_packed_size(int n, int k, int nr);
-// Output columns [begin, end) of a depthwise row whose kernel_w taps all fall inside an
-// input row of in_w pixels (DepthwiseRowArgs::interior_begin and interior_end).
-void depthwise_interior_columns(const ConvParams& p, int in_w, int out_w, int& begin, int& end);
 void pack_gemm_weights(const float* b, const float* bias, int n, int k, int nr, float* packed);
 
 class Conv2d {
@@ -71,11 +68,13 @@ class Conv2d {
   const ConvParams& params() const { return p_; }
   Path path() const { return path_; }
   // For ops that call the micro-kernels themselves (kernels/inverted_residual.h): the
-  // table the weights were packed for, and the packed weights (pointwise and general: one
-  // pack_gemm_weights block per group; depthwise: [kernel_h][kernel_w][channels] weights,
-  // then [channels] bias).
+  // table the weights were packed for, and the arguments of its kernels for this layer.
   const KernelTable& table() const { return *k_; }
-  const float* packed() const { return packed_.get(); }
+  // Depthwise: a row of out_w outputs from input rows of in_w pixels, output column 0
+  // reading input column -pad_left; in_rows, out and residual are the caller's to set.
+  DepthwiseRowArgs depthwise_row_args(int in_w, int out_w, int pad_left) const;
+  // Pointwise: everything but the rows (m, a, c, residual).
+  GemmArgs pointwise_gemm_args() const;
 
   // in: NHWC [in_h][in_w][in_c]; out: [out_h][out_w][out_c];
   // out = act(conv(in) + bias) + residual   (residual: nullptr or the shape of out)
@@ -90,6 +89,9 @@ class Conv2d {
                         const float* residual = nullptr, ThreadPool& pool = default_pool()) const;
 
  private:
+  // Throws std::runtime_error naming `method` on an empty Conv2d, or on an input that is
+  // empty or too small for the dilated kernel.
+  void check_input(const char* method, int in_h, int in_w) const;
   void run_pointwise(const float* packed, const float* in, int64_t pixels, float* out,
                      const float* residual, ThreadPool& pool) const;
   void run_depthwise(const float* in, int in_h, int in_w, float* out, const float* residual,

@@ -46,13 +46,7 @@ void check_chain(const std::optional<Conv2d>& expand, const Conv2d& dw, const Co
 // pixel gets the bits Conv2d::run_pointwise gives it, wherever the tiles start.
 void pointwise_rows(const Conv2d& conv, const float* a, int64_t pixels, float* c, const float* residual) {
   const KernelTable& k = conv.table();
-  GemmArgs g;
-  g.n = conv.params().out_c;
-  g.k = conv.params().in_c;
-  g.a_stride = g.k;
-  g.packed = conv.packed();
-  g.c_stride = g.n;
-  g.act = conv.params().act;
+  GemmArgs g = conv.pointwise_gemm_args();
   for (int64_t row = 0; row < pixels; row += k.gemm_mr) {
     g.m = static_cast<int>(std::min<int64_t>(k.gemm_mr, pixels - row));
     g.a = a + row * g.k;
@@ -111,28 +105,16 @@ void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, fl
   const int cx0 = std::max(0, t.x0 - d.pad_left);
   const int cx1 = std::min(w, t.x1 - 1 - d.pad_left + (d.kernel_w - 1) * d.dilation_w + 1);
   const int cols = cx1 - cx0, out_w = t.x1 - t.x0;
-  ConvParams local = d;
-  local.pad_left = cx0 - t.x0 + d.pad_left;
-  DepthwiseRowArgs a;
-  a.in_w = cols;
-  a.channels = expanded_;
-  a.kernel_h = d.kernel_h;
-  a.kernel_w = d.kernel_w;
-  a.dilation_w = d.dilation_w;
-  a.pad_left = local.pad_left;
-  a.out_w = out_w;
-  depthwise_interior_columns(local, cols, out_w, a.interior_begin, a.interior_end);
-  a.weights = dw_.packed();
-  a.bias = dw_.packed() + int64_t(d.kernel_h) * d.kernel_w * expanded_;
-  a.act = d.act;
+  DepthwiseRowArgs a = dw_.depthwise_row_args(cols, out_w, cx0 - t.x0 + d.pad_left);
 
   const int64_t ring_row = int64_t(ring_w) * expanded_;
   if (expand_ && s.ring.size() < size_t(span * ring_row)) s.ring.resize(size_t(span * ring_row));
   if (s.dw_row.size() < size_t(out_w) * expanded_) s.dw_row.resize(size_t(out_w) * expanded_);
-  // Input row r's columns [cx0, cx1) after the expansion: a ring slot, filled on first use.
+  // Input row r's columns [cx0, cx1) after the expansion: its ring slot, or the input
+  // itself when there is no expansion.
+  const auto ring_slot = [&](int r) { return s.ring.data() + (r % span) * ring_row; };
   const auto expanded_row = [&](int r) -> const float* {
-    if (!expand_) return in + (int64_t(r) * w + cx0) * in_c_;
-    return s.ring.data() + (r % span) * ring_row;
+    return expand_ ? ring_slot(r) : in + (int64_t(r) * w + cx0) * in_c_;
   };
   int next_row = std::max(0, t.y0 - d.pad_top);  // the first row not yet expanded
   std::array<const float*, kMaxKernelH> rows;
@@ -140,8 +122,7 @@ void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, fl
   for (int y = t.y0; y < t.y1; ++y) {
     const int top = y - d.pad_top;
     for (const int last = std::min(h, top + span); expand_ && next_row < last; ++next_row)
-      pointwise_rows(*expand_, in + (int64_t(next_row) * w + cx0) * in_c_, cols,
-                     s.ring.data() + (next_row % span) * ring_row, nullptr);
+      pointwise_rows(*expand_, in + (int64_t(next_row) * w + cx0) * in_c_, cols, ring_slot(next_row), nullptr);
     for (int ky = 0; ky < d.kernel_h; ++ky) {
       const int iy = top + ky * d.dilation_h;
       rows[ky] = iy >= 0 && iy < h ? expanded_row(iy) : nullptr;
