@@ -31,6 +31,11 @@ constexpr int kTapsMaxOutputs = 4;
 constexpr int kTapsBandsPerThread = 4;
 constexpr int kTapsMinBandSeams = 4;
 
+// Rows path: a gemm call reads a run of at least this many contiguous input floats
+// (kernel_w * in_c, or in_c when the taps are dilated across the row); shorter runs would
+// spend more on reloading the output tile between calls than im2col's copies cost.
+constexpr int kRowsMinRun = 16;
+
 // Outputs (depthwise and pointwise) larger than this many last-level caches go out with
 // streaming stores (DepthwiseRowArgs::stream_out, GemmArgs::stream_c). Outputs that may
 // still be cached when the next layer reads them keep plain stores: streaming a 12 MB
@@ -84,6 +89,11 @@ int out_size(int in, int pad_before, int pad_after, int kernel, int dilation, in
   return span < 0 ? 0 : span / stride + 1;
 }
 
+// Rows path: the taps one gemm call covers. Without dilation across the row, a kernel
+// row's taps read one contiguous run of the (padded) input row; with it, each tap is its
+// own run.
+int rows_run_taps(const ConvParams& p) { return p.dilation_w == 1 ? p.kernel_w : 1; }
+
 Conv2d::Path choose_path(const ConvParams& p) {
   const bool no_padding = p.pad_top == 0 && p.pad_left == 0 && p.pad_bottom == 0 && p.pad_right == 0;
   if (p.groups == 1 && p.kernel_h == 1 && p.kernel_w == 1 && p.stride_h == 1 && p.stride_w == 1 &&
@@ -94,6 +104,7 @@ Conv2d::Path choose_path(const ConvParams& p) {
   if (p.groups == 1 && p.out_c <= kTapsMaxOutputs && p.stride_h == 1 && p.stride_w == 1 &&
       p.kernel_h * p.kernel_w > 1)
     return Conv2d::Path::Taps;
+  if (p.groups == 1 && rows_run_taps(p) * p.in_c >= kRowsMinRun) return Conv2d::Path::Rows;
   return Conv2d::Path::General;
 }
 
@@ -246,6 +257,23 @@ Conv2d::Conv2d(const ConvParams& p, const float* weights, const float* bias, con
     packed_ = packed;
     return;
   }
+  if (path_ == Path::Rows) {
+    // One bias-free block per run (kernel row ky, taps kx0..kx0+run-1): [out_c][run*in_c]
+    // is a contiguous slice of each OHWI filter row.
+    const int run = rows_run_taps(p), runs = taps / run, kdim = run * p.in_c;
+    group_stride_ = gemm_packed_size(p.out_c, kdim, k.gemm_nr);
+    std::shared_ptr<float> packed = allocate_floats(group_stride_ * runs + p.out_c);
+    std::vector<float> slice(static_cast<size_t>(p.out_c) * kdim);
+    for (int r = 0; r < runs; ++r) {
+      for (int j = 0; j < p.out_c; ++j)
+        std::copy_n(weights + (static_cast<int64_t>(j) * taps + r * run) * p.in_c, kdim,
+                    slice.begin() + static_cast<int64_t>(j) * kdim);
+      pack_gemm_weights(slice.data(), nullptr, p.out_c, kdim, k.gemm_nr, packed.get() + r * group_stride_);
+    }
+    for (int j = 0; j < p.out_c; ++j) packed.get()[group_stride_ * runs + j] = bias ? bias[j] : 0.0f;
+    packed_ = packed;
+    return;
+  }
   const int cout_g = p.out_c / p.groups;
   const int kdim = taps * (p.in_c / p.groups);
   group_stride_ = gemm_packed_size(cout_g, kdim, k.gemm_nr);
@@ -275,6 +303,7 @@ void Conv2d::run(const float* in, int in_h, int in_w, float* out, const float* r
       break;
     case Path::Depthwise: run_depthwise(in, in_h, in_w, out, residual, pool); break;
     case Path::Taps: run_taps(in, in_h, in_w, out, residual, pool); break;
+    case Path::Rows: run_rows(in, in_h, in_w, out, residual, pool); break;
     case Path::General: run_general(in, in_h, in_w, out, residual, pool); break;
   }
 }
@@ -425,6 +454,74 @@ void Conv2d::run_taps(const float* in, int in_h, int in_w, float* out, const flo
         k_->activate(row_out, row_values, p_.act);
         if (residual) k_->add(row_out, residual + static_cast<int64_t>(y) * row_values, row_values, {}, row_out);
       }
+    }
+  });
+}
+
+void Conv2d::run_rows(const float* in, int in_h, int in_w, float* out, const float* residual,
+                      ThreadPool& pool) const {
+  const int out_h = p_.out_h(in_h), out_w = p_.out_w(in_w), c = p_.in_c, out_c = p_.out_c;
+  const int run = rows_run_taps(p_), runs_per_row = p_.kernel_w / run;
+  const int span = (p_.kernel_h - 1) * p_.dilation_h + 1;  // input rows one output row reads
+  const bool pad_columns = p_.pad_left > 0 || p_.pad_right > 0;
+  const int64_t padded_floats = static_cast<int64_t>(p_.pad_left + in_w + p_.pad_right) * c;
+  const float* bias = packed_.get() + group_stride_ * p_.kernel_h * runs_per_row;
+  const int64_t row_values = static_cast<int64_t>(out_w) * out_c;
+  GemmArgs base;
+  base.n = out_c;
+  base.k = run * c;
+  base.a_stride = static_cast<int64_t>(p_.stride_w) * c;
+  base.c_stride = out_c;
+  pool.parallel_for(out_h, 1, [&](int64_t first, int64_t last) {
+    // With horizontal padding, input rows are copied between zero columns, into a ring of
+    // span rows (input row iy in slot iy % span) so consecutive output rows share them.
+    float* ring = pad_columns ? im2col_scratch(static_cast<size_t>(span * padded_floats)) : nullptr;
+    std::vector<int> held(span, -1);
+    auto padded_row = [&](int iy) -> const float* {
+      const float* src = in + static_cast<int64_t>(iy) * in_w * c;
+      if (!pad_columns) return src;
+      float* row = ring + (iy % span) * padded_floats;
+      if (held[iy % span] != iy) {
+        std::fill_n(row, static_cast<int64_t>(p_.pad_left) * c, 0.0f);
+        std::copy_n(src, static_cast<int64_t>(in_w) * c, row + static_cast<int64_t>(p_.pad_left) * c);
+        std::fill_n(row + static_cast<int64_t>(p_.pad_left + in_w) * c, static_cast<int64_t>(p_.pad_right) * c, 0.0f);
+        held[iy % span] = static_cast<int>(iy);
+      }
+      return row;
+    };
+    // The bias repeated along a row: the first run's gemm adds it as its residual.
+    std::vector<float> bias_row(static_cast<size_t>(row_values));
+    for (int x = 0; x < out_w; ++x) std::copy_n(bias, out_c, bias_row.begin() + static_cast<int64_t>(x) * out_c);
+    std::vector<const float*> rows(p_.kernel_h);
+    GemmArgs g = base;
+    for (int64_t y = first; y < last; ++y) {
+      for (int ky = 0; ky < p_.kernel_h; ++ky) {
+        const int iy = static_cast<int>(y) * p_.stride_h - p_.pad_top + ky * p_.dilation_h;
+        rows[ky] = iy >= 0 && iy < in_h ? padded_row(iy) : nullptr;  // rows in the padding add nothing
+      }
+      float* row_out = out + y * row_values;
+      // Each run's gemm adds its product to the output tile (residual = c after the
+      // first), so a tile's accumulators pass through memory once per run; it stays in L1.
+      for (int x = 0; x < out_w; x += k_->gemm_mr) {
+        g.m = std::min(k_->gemm_mr, out_w - x);
+        g.c = row_out + static_cast<int64_t>(x) * out_c;
+        g.residual = bias_row.data() + static_cast<int64_t>(x) * out_c;
+        for (int ky = 0; ky < p_.kernel_h; ++ky) {
+          if (!rows[ky]) continue;
+          for (int r = 0; r < runs_per_row; ++r) {
+            // Padded column of output x's first tap in this run: x*stride + kx*dilation.
+            const int64_t column = static_cast<int64_t>(x) * p_.stride_w + static_cast<int64_t>(r) * run * p_.dilation_w;
+            g.a = rows[ky] + column * c;
+            g.packed = packed_.get() + (ky * runs_per_row + r) * group_stride_;
+            k_->gemm(g);
+            g.residual = g.c;
+          }
+        }
+        if (g.residual != g.c)  // every kernel row fell in the padding: the output is the bias
+          std::copy_n(g.residual, static_cast<int64_t>(g.m) * out_c, g.c);
+      }
+      k_->activate(row_out, row_values, p_.act);
+      if (residual) k_->add(row_out, residual + y * row_values, row_values, {}, row_out);
     }
   });
 }

@@ -15,11 +15,17 @@
 //              AVX-512 tile's lanes or less. Instead one gemm over each input row gives
 //              every tap's contribution (kernel_h*kernel_w*out_c columns), and each output
 //              pixel adds its taps' contributions from the rows and columns they read.
-//   general    anything else: per pixel tile and group, im2col into a per-thread scratch
-//              buffer, then the same gemm tile.
-// Threads split the output pixels (pointwise, general) or output rows (depthwise, taps); every
-// output value is computed by the same code in the same order whatever the thread count,
-// so results are bitwise identical across thread counts.
+//   rows       any other convolution with one group (implicit GEMM): for an output row,
+//              the gemm's A rows are read straight from the input rows, a_stride
+//              stride_w*in_c apart; one call per kernel row adds a run of kernel_w*in_c
+//              contiguous inputs (one call per tap when dilated across the row) into the
+//              output tile. Rows with horizontal padding are copied between zero columns
+//              once, not once per tap as im2col does.
+//   general    anything else (grouped, or runs under 16 floats): per pixel tile and group,
+//              im2col into a per-thread scratch buffer, then the same gemm tile.
+// Threads split the output pixels (pointwise, general) or output rows (depthwise, taps,
+// rows); every output value is computed by the same code in the same order whatever the
+// thread count, so results are bitwise identical across thread counts.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -57,7 +63,7 @@ void pack_gemm_weights(const float* b, const float* bias, int n, int k, int nr, 
 
 class Conv2d {
  public:
-  enum class Path { Pointwise, Depthwise, Taps, General };
+  enum class Path { Pointwise, Depthwise, Taps, Rows, General };
 
   Conv2d() = default;
   // weights OHWI [out_c][kernel_h][kernel_w][in_c/groups]; bias [out_c] or nullptr.
@@ -98,6 +104,8 @@ class Conv2d {
                      ThreadPool& pool) const;
   void run_taps(const float* in, int in_h, int in_w, float* out, const float* residual,
                 ThreadPool& pool) const;
+  void run_rows(const float* in, int in_h, int in_w, float* out, const float* residual,
+                ThreadPool& pool) const;
   void run_general(const float* in, int in_h, int in_w, float* out, const float* residual,
                    ThreadPool& pool) const;
 
@@ -107,6 +115,8 @@ class Conv2d {
   // Packed weights, immutable after construction (shared by copies of this Conv2d).
   // Pointwise/general: one pack_gemm_weights block per group, group_stride_ floats apart.
   // Depthwise: [kernel_h][kernel_w][channels] weights, then [channels] bias.
+  // Rows: one pack_gemm_weights block without bias per run (kernel row, then run within
+  // the row), group_stride_ floats apart, then [out_c] bias.
   // Taps: one pack_gemm_weights block without bias (column tap * out_c + j holds output
   // j's weights of one tap), group_stride_ floats, then [out_c] bias.
   std::shared_ptr<const float> packed_;

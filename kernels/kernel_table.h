@@ -26,7 +26,9 @@ struct GemmArgs {
   const float* packed = nullptr;    // packed bias and B for this table's gemm_nr
   float* c = nullptr;               // m rows of n floats, c_stride floats apart
   int64_t c_stride = 0;
-  const float* residual = nullptr;  // nullptr, or laid out like c (same stride)
+  // nullptr, or laid out like c (same stride); may be c itself, to accumulate into it:
+  // every kernel reads a residual value before it writes that element of c.
+  const float* residual = nullptr;
   ActivationSpec act;
   // The whole output is larger than the last-level cache (it is evicted before the next
   // layer reads it back), c and c_stride are 64-byte aligned and n a multiple of 16:

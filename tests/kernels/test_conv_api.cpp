@@ -27,7 +27,10 @@ std::vector<ConvCase> one_case_per_path(uint32_t seed) {
   ConvCase taps = general;
   taps.p.in_c = 24;
   taps.p.out_c = 4;
-  std::vector<ConvCase> cases = {pointwise, depthwise, general, taps};
+  ConvCase rows = general;
+  rows.p.in_c = 12;
+  rows.p.out_c = 19;
+  std::vector<ConvCase> cases = {pointwise, depthwise, general, taps, rows};
   for (ConvCase& c : cases) c.seed = seed++;
   return cases;
 }
@@ -76,18 +79,26 @@ TEST_CASE("Conv2d picks the path by shape") {
   CHECK(path_of(cases[1].p) == Conv2d::Path::Depthwise);
   CHECK(path_of(cases[2].p) == Conv2d::Path::General);
   CHECK(path_of(cases[3].p) == Conv2d::Path::Taps);
+  CHECK(path_of(cases[4].p) == Conv2d::Path::Rows);
   ConvParams five_outputs = cases[3].p;
   five_outputs.out_c = 5;
-  CHECK(path_of(five_outputs) == Conv2d::Path::General);
+  CHECK(path_of(five_outputs) == Conv2d::Path::Rows);
   ConvParams strided_taps = cases[3].p;
   strided_taps.stride_h = 2;
-  CHECK(path_of(strided_taps) == Conv2d::Path::General);
+  CHECK(path_of(strided_taps) == Conv2d::Path::Rows);
   ConvParams grouped_taps = cases[3].p;
   grouped_taps.groups = 2;
   CHECK(path_of(grouped_taps) == Conv2d::Path::General);
   ConvParams strided = cases[0].p;
   strided.stride_w = 2;
-  CHECK(path_of(strided) == Conv2d::Path::General);
+  CHECK(path_of(strided) == Conv2d::Path::Rows);
+  // A run is kernel_w * in_c floats, or in_c when the taps are dilated across the row:
+  // under 16, im2col's copies cost less than reloading the output tile per run.
+  ConvParams dilated = cases[4].p;
+  dilated.dilation_w = 2;
+  CHECK(path_of(dilated) == Conv2d::Path::General);
+  dilated.in_c = 16;
+  CHECK(path_of(dilated) == Conv2d::Path::Rows);
   ConvParams multiplier = cases[1].p;
   multiplier.out_c = 66;
   CHECK(path_of(multiplier) == Conv2d::Path::General);

@@ -1,6 +1,8 @@
-// General convolution (im2col + GEMM) and the taps path of few-output convolutions
-// (Conv2d::Path::Taps, chosen by shape): every kernel size, stride, padding, dilation and
-// group count the networks use, every runnable ISA against the direct reference.
+// Every convolution that is neither pointwise nor depthwise: the rows path (implicit
+// GEMM on the input rows), the taps path of few-output convolutions and the general
+// path (im2col + GEMM), each chosen by shape. Every kernel size, stride, padding,
+// dilation and group count the networks use, every runnable ISA against the direct
+// reference.
 #include "test_conv_util.h"
 
 using namespace ampi;
@@ -119,4 +121,41 @@ TEST_CASE("few-output conv (the taps path) matches the reference: channels, kern
             if (fits(c)) check_all_isas(c, pool);
           }
         }
+}
+
+TEST_CASE("rows path (implicit GEMM) matches the reference: runs, strides, paddings, dilations") {
+  ThreadPool pool(2);
+  uint32_t seed = 9800;
+  const auto path_of = [](const ConvCase& c) {
+    const ConvData d(c);
+    return Conv2d(c.p, d.weights.data(), nullptr).path();
+  };
+  // in_c around the 16-float run threshold and the vector widths; out_c past one panel.
+  for (int in_c : sweep<int>({2, 5, 6, 8, 12, 16, 17, 33}, {5, 16}))
+    for (int out_c : sweep<int>({5, 16, 17, 40}, {17}))
+      for (int kernel : sweep<int>({1, 3, 5}, {3}))
+        for (int stride : {1, 2})
+          for (int dilation : sweep<int>({1, 2}, {1, 2})) {
+            const int reach = (kernel - 1) * dilation;
+            ConvCase c = general(in_c, out_c, kernel, stride, dilation, 1, sweep<int>({29}, {11}).front(), 31, seed++);
+            set_padding(c, reach / 2, reach - reach / 2, reach, reach / 2 + 1);
+            if (!fits(c)) continue;
+            const int run = dilation == 1 ? kernel * in_c : in_c;
+            INFO(describe(c));
+            CHECK((path_of(c) == Conv2d::Path::Rows) == (run >= 16));
+            check_all_isas(c, pool);
+          }
+  SECTION("padding wider than the kernel: rows and columns that read only zeros give the bias") {
+    ConvCase c = general(8, 20, 3, 1, 1, 1, 6, 7, seed++);
+    set_padding(c, 4, 4, 3, 5);
+    c.residual = true;
+    CHECK(path_of(c) == Conv2d::Path::Rows);
+    check_all_isas(c, pool);
+  }
+  SECTION("no horizontal padding: A is read from the input rows themselves") {
+    ConvCase c = general(12, 16, 3, 1, 1, 1, 9, 40, seed++);
+    set_padding(c, 1, 0, 1, 0);
+    CHECK(path_of(c) == Conv2d::Path::Rows);
+    check_all_isas(c, pool);
+  }
 }
