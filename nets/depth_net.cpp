@@ -44,6 +44,36 @@ struct Block {
 
 using Stage = std::vector<Block>;
 
+// The network's input step: the caller's rgb_h x rgb_w image normalised per channel,
+// its last row and column replicated out to h x w (so the network sees no artificial
+// edge), then one Haar DWT with haar_dwt's arithmetic, into out [h/2][w/2][12]. One
+// pass: the normalised full-resolution image is never stored, and its three channels
+// never go through a vector kernel that would fill 3 lanes.
+void normalise_and_dwt(const float* rgb, int rgb_h, int rgb_w, int h, int w, const float* mean,
+                       const float* inv_std, float* out, ThreadPool& pool) {
+  const int out_w = w / 2;
+  pool.parallel_for(h / 2, 4, [&](int64_t y0, int64_t y1) {
+    for (int64_t y = y0; y < y1; ++y) {
+      const float* top = rgb + std::min<int64_t>(2 * y, rgb_h - 1) * rgb_w * 3;
+      const float* bottom = rgb + std::min<int64_t>(2 * y + 1, rgb_h - 1) * rgb_w * 3;
+      float* dst = out + y * out_w * 12;
+      for (int x = 0; x < out_w; ++x, dst += 12) {
+        const int left = std::min(2 * x, rgb_w - 1) * 3, right = std::min(2 * x + 1, rgb_w - 1) * 3;
+        for (int j = 0; j < 3; ++j) {
+          const auto at = [&](const float* row, int column) { return (row[column + j] - mean[j]) * inv_std[j]; };
+          const float x00 = at(top, left), x01 = at(top, right), x10 = at(bottom, left), x11 = at(bottom, right);
+          const float top_sum = x00 + x01, top_diff = x00 - x01;
+          const float bottom_sum = x10 + x11, bottom_diff = x10 - x11;
+          dst[j] = (top_sum + bottom_sum) * 0.5f;
+          dst[3 + j] = (top_diff + bottom_diff) * 0.5f;
+          dst[6 + j] = (top_sum - bottom_sum) * 0.5f;
+          dst[9 + j] = (top_diff - bottom_diff) * 0.5f;
+        }
+      }
+    }
+  });
+}
+
 [[noreturn]] void fail(const WeightFile& f, const std::string& problem) {
   throw std::runtime_error(f.path() + ": " + problem);
 }
@@ -318,28 +348,21 @@ int DepthNet::Impl::add_stage(Plan& p, const Stage& stage, int x, int h, int w) 
 std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
   auto p = std::make_unique<Plan>();
   const KernelTable& k = *table;
-  // Step 0: normalise the caller's image and replicate its last row and column into the
-  // padding, so the network sees no artificial edge.
-  int x = p->produce(h, w, 3);
-  p->push([this, x, h, w](Plan& pl, ThreadPool& pool) {
-    float* out = pl.data(x);
-    pool.parallel_for(h, 8, [&](int64_t y0, int64_t y1) {
-      for (int64_t y = y0; y < y1; ++y) {
-        const float* row = pl.rgb + size_t(std::min<int64_t>(y, pl.rgb_h - 1)) * pl.rgb_w * 3;
-        for (int xx = 0; xx < w; ++xx) {
-          const float* px = row + size_t(std::min(xx, pl.rgb_w - 1)) * 3;
-          for (int c = 0; c < 3; ++c) out[(size_t(y) * w + xx) * 3 + c] = (px[c] - mean[c]) * inv_std[c];
-        }
-      }
-    });
-  });
-
-  std::vector<int> skips;
+  // The encoder: per stage a Haar DWT, then its blocks. The first DWT reads the caller's
+  // image itself (normalise_and_dwt); until then there is no map x.
   int c = 3, lh = h, lw = w;
+  int x = -1;
+  std::vector<int> skips;
   for (const Stage& stage : encoder) {
     const int d = p->produce(lh / 2, lw / 2, 4 * c);
-    p->consume(x);
-    p->push([&k, x, d, lh, lw, c](Plan& pl, ThreadPool& pool) { haar_dwt(pl.data(x), lh, lw, c, pl.data(d), pool, k); });
+    if (x < 0) {
+      p->push([this, d, h, w](Plan& pl, ThreadPool& pool) {
+        normalise_and_dwt(pl.rgb, pl.rgb_h, pl.rgb_w, h, w, mean, inv_std, pl.data(d), pool);
+      });
+    } else {
+      p->consume(x);
+      p->push([&k, x, d, lh, lw, c](Plan& pl, ThreadPool& pool) { haar_dwt(pl.data(x), lh, lw, c, pl.data(d), pool, k); });
+    }
     lh /= 2;
     lw /= 2;
     x = add_stage(*p, stage, d, lh, lw);
