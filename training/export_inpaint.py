@@ -92,6 +92,24 @@ def generator_tensors(g: im.InpaintGenerator):
     return tensors
 
 
+def import_ampw(path: str) -> im.InpaintGenerator:
+    """The generator of an exported file (the inverse of export): what lets a run on a
+    fresh checkout start from the bundled weights, which have no checkpoint beside them."""
+    from weights_format.ampw import read_ampw
+    meta, tensors = read_ampw(path)
+    if meta.get("model") != "ampi-inpaint":
+        raise ValueError(f"{path}: model {meta.get('model')!r} is not ampi-inpaint")
+    g = im.InpaintGenerator(residual=int(meta["inpaint.version"]) == 2)
+    if meta["inpaint.layer_names"] != ",".join(row[0] for row in g.layers_spec):
+        raise ValueError(f"{path}: its graph is not training/inpaint_model.py's LAYERS")
+    with torch.no_grad():
+        for (name, *_rest), module in zip(g.layers_spec, g.convs):
+            conv = module.conv if isinstance(module, im.GatedConv) else module
+            conv.weight.copy_(torch.from_numpy(tensors[name + ".weight"].transpose(0, 3, 1, 2).copy()))
+            conv.bias.copy_(torch.from_numpy(tensors[name + ".bias"]))
+    return g
+
+
 def export(g: im.InpaintGenerator, path: str, extra_metadata=None):
     meta = graph_metadata(g.layers_spec, g.version)
     meta.update(extra_metadata or {})

@@ -44,6 +44,7 @@ import depth_model  # noqa: E402
 import inpaint_data as data  # noqa: E402
 from inpaint_model import InpaintGenerator, PatchDiscriminator  # noqa: E402
 from losses import gradient_loss  # noqa: E402
+from export_inpaint import import_ampw as import_generator  # noqa: E402
 
 W_GRAD, W_DISC, W_PERC = 0.1, 0.01, 0.01
 LR_G, LR_D, BETAS = 2e-4, 1e-4, (0.5, 0.999)
@@ -61,7 +62,13 @@ class PerceptualFeatures(torch.nn.Module):
         torch.manual_seed(PERCEPTUAL_SEED)
         net = depth_model.build("lite")
         self.source = "random-init(seed=%d)" % PERCEPTUAL_SEED
-        if checkpoint:
+        if checkpoint and checkpoint.endswith(".ampw"):
+            # Folded weights: in eval mode the imported network computes exactly the
+            # trained one, and these features only ever run in eval mode.
+            import export_depth
+            net = export_depth.import_ampw(checkpoint)
+            self.source = os.path.abspath(checkpoint)
+        elif checkpoint:
             state = torch.load(checkpoint, map_location="cpu")
             net.load_state_dict(state.get("model", state))
             self.source = os.path.abspath(checkpoint)
@@ -193,7 +200,10 @@ def parse_args(argv):
     ap.add_argument("--photos", default=data.DEFAULT_PHOTOS)
     ap.add_argument("--disparity-dir", default=data.DEFAULT_DISPARITY_DIR)
     ap.add_argument("--run-dir", default=os.path.join(os.path.dirname(__file__), "runs", "inpaint"))
-    ap.add_argument("--perceptual", default=None, help="depth network checkpoint for L_perc")
+    ap.add_argument("--perceptual", default=None,
+                    help="depth network for L_perc: a train_depth.py checkpoint or an exported .ampw")
+    ap.add_argument("--init", default=None,
+                    help="a new run's generator starts from this exported .ampw (the bundled weights)")
     ap.add_argument("--lr-g", type=float, default=LR_G, help="generator learning rate (paper: 2e-4)")
     ap.add_argument("--lr-d", type=float, default=LR_D, help="discriminator learning rate (paper: 1e-4)")
     ap.add_argument("--steps", type=int, default=1_000_000, help="stop after this many steps")
@@ -230,6 +240,11 @@ def main(argv=None):
 
     torch.manual_seed(args.seed)
     g, d = InpaintGenerator(residual=not args.plain), PatchDiscriminator()
+    if args.init:
+        g = import_generator(args.init)
+        if g.residual == args.plain:
+            raise SystemExit(f"{args.init}: its generator version does not match --plain")
+        log(f"generator starts from {args.init}")
     phi = PerceptualFeatures(args.perceptual)
     log(f"perceptual features: depth encoder, {phi.source}")
     opt_g = torch.optim.Adam(g.parameters(), lr=args.lr_g, betas=BETAS)
