@@ -51,6 +51,8 @@ const char kUsage[] =
     "                          file asks for; layers are always cut at full resolution)\n"
     "  --max-planes N          at most N planes (default 8)\n"
     "  --uniform               equal disparity intervals (the paper's baseline)\n"
+    "  --min-plane-share F     adaptive cuts leave each plane more than F/N of the depth\n"
+    "                          histogram, N = --max-planes (default 0.5; 0: the paper's rule)\n"
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
     "  --inpainter NAME        network (default) or push-pull (faster): what fills occluded margins\n"
     "  --inpaint-weights FILE  inpainting network weight file (implies --inpainter network)\n"
@@ -99,6 +101,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--working-size", &a.mpi.working_size, kMinPhotoSide, 16384);
   p.option("--max-planes", &a.mpi.slicing.max_planes, 1, kDisparityLevels - 1);
   p.flag("--uniform", &a.mpi.uniform);
+  p.option("--min-plane-share", &a.mpi.slicing.min_plane_share, 0.0, 0.99);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
   p.option("--inpainter", [&](const std::string& v) {

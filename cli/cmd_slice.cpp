@@ -13,7 +13,8 @@ namespace ampi::cli {
 namespace {
 
 const char kUsage[] =
-    "usage: ampi slice DEPTH [--max-planes N] [--uniform] [--depth-is-distance]\n"
+    "usage: ampi slice DEPTH [--max-planes N] [--min-plane-share F] [--uniform]\n"
+    "                        [--depth-is-distance]\n"
     "\n"
     "Cuts a depth map into planes (the paper's adaptive slicing unless --uniform) and\n"
     "prints them back to front as JSON: {\"planes\": [{\"depth\", \"disparity\", \"interval\",\n"
@@ -24,12 +25,16 @@ const char kUsage[] =
     "  DEPTH                 disparity map (larger = nearer): PNG (8/16-bit), TIFF, .npy\n"
     "  --max-planes N        at most N planes (1..255; default 8); with --uniform, exactly\n"
     "                        N equal intervals, of which empty ones are dropped\n"
+    "  --min-plane-share F   adaptive cuts leave each plane more than F/N of the depth\n"
+    "                        histogram, N = --max-planes, F in 0..0.99 (default 0.5; 0: the\n"
+    "                        paper's rule exactly, which only refuses empty planes)\n"
     "  --uniform             equal disparity intervals (the paper's baseline)\n"
     "  --depth-is-distance   DEPTH holds distances (larger = farther), not disparity\n";
 
 struct SliceOptions {
   std::string depth_path;
   int max_planes = SlicingParams{}.max_planes;
+  double min_plane_share = SlicingParams{}.min_plane_share;
   bool uniform = false;
   bool depth_is_distance = false;
 };
@@ -42,6 +47,14 @@ int parse_plane_count(const char* text) {
   return static_cast<int>(n);
 }
 
+double parse_min_plane_share(const char* text) {
+  char* end = nullptr;
+  const double f = std::strtod(text, &end);
+  if (end == text || *end != '\0' || !(f >= 0 && f <= 0.99))
+    throw std::runtime_error(std::string("--min-plane-share: '") + text + "' is not a number in 0..0.99");
+  return f;
+}
+
 SliceOptions parse(int argc, char** argv) {
   SliceOptions o;
   for (int i = 1; i < argc; ++i) {
@@ -49,6 +62,9 @@ SliceOptions parse(int argc, char** argv) {
     if (arg == "--max-planes") {
       if (i + 1 >= argc) throw std::runtime_error("--max-planes needs a number");
       o.max_planes = parse_plane_count(argv[++i]);
+    } else if (arg == "--min-plane-share") {
+      if (i + 1 >= argc) throw std::runtime_error("--min-plane-share needs a number");
+      o.min_plane_share = parse_min_plane_share(argv[++i]);
     } else if (arg == "--uniform") {
       o.uniform = true;
     } else if (arg == "--depth-is-distance") {
@@ -87,6 +103,7 @@ int cmd_slice(int argc, char** argv) {
   const cv::Mat disparity = read_depth_map(o.depth_path, o.depth_is_distance);
   SlicingParams params;
   params.max_planes = o.max_planes;
+  params.min_plane_share = o.min_plane_share;
   print_planes(o.uniform ? slice_uniform(disparity, o.max_planes, params.range) : slice_adaptive(disparity, params));
   return 0;
 }

@@ -91,6 +91,7 @@ std::vector<SlicingScore> SlicingEvaluator::add(const cv::Mat& bgr, const cv::Ma
   for (int count : options_.counts) {
     SlicingParams params;
     params.max_planes = count;
+    params.min_plane_share = options_.min_plane_share;
     params.range = options_.range;
     const std::vector<Plane> adaptive = slice_adaptive(disparity, params);
     rows.push_back(score(count, "uniform", slice_uniform(disparity, int(adaptive.size()), options_.range)));

@@ -26,6 +26,7 @@
 #include "inpaint/mpi_inpaint.h"
 #include "mpi/mpi.h"
 #include "render/pose.h"
+#include "slicing/adaptive.h"
 
 namespace ampi {
 
@@ -40,6 +41,7 @@ struct SlicingEvalOptions {
   double amplitude = 0.05;               // circle radius / nearest reference plane depth, in (0, 1)
   double fov_degrees = 60;               // assumed horizontal field of view
   DepthRange range;                      // where normalised disparity puts the planes
+  double min_plane_share = SlicingParams{}.min_plane_share;  // the adaptive slicer's guard
 };
 
 // One row of the table: a count and a method, averaged over photos.

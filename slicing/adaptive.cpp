@@ -20,6 +20,7 @@ void check_params(const SlicingParams& p) {
   require(p.max_planes >= 1 && p.max_planes <= kDisparityLevels - 1, "max_planes must be in 1..255");
   require(p.eps > 0, "eps must be positive");
   require(p.xi >= 0, "xi must not be negative");
+  require(p.min_plane_share >= 0 && p.min_plane_share < 1, "min_plane_share must be in [0, 1)");
   require(p.bilateral_diameter >= 1, "bilateral_diameter must be at least 1");
   require(p.bilateral_sigma_color > 0 && p.bilateral_sigma_space > 0, "bilateral sigmas must be positive");
   require(p.canny_low >= 0 && p.canny_high >= p.canny_low, "Canny thresholds must satisfy 0 <= low <= high");
@@ -65,7 +66,7 @@ std::vector<double> transition_index(const std::vector<double>& h, double eps) {
 }
 
 std::vector<int> select_transitions(const std::vector<double>& t, const std::vector<double>& h,
-                                    int xi, double threshold, int max_selected) {
+                                    int xi, double threshold, int max_selected, double min_mass) {
   CV_Assert(t.size() == h.size());
   const int n = static_cast<int>(t.size());
   std::vector<int> selected;
@@ -81,12 +82,12 @@ std::vector<int> select_transitions(const std::vector<double>& t, const std::vec
     const auto above = std::upper_bound(boundaries.begin(), boundaries.end(), i);
     const int lo = *(above - 1);
     const int end = *above == n - 1 ? n : *above;  // the top interval holds the last bin
-    if (mass(prefix, lo, i) > 0 && mass(prefix, i, end) > 0) {
+    if (mass(prefix, lo, i) > min_mass && mass(prefix, i, end) > min_mass) {
       selected.push_back(i);
       boundaries.insert(above, i);
       std::fill(work.begin() + std::max(0, i - xi), work.begin() + std::min(n, i + xi + 1), 0.0);
     } else {
-      work[i] = 0.0;  // would only cut off an empty interval
+      work[i] = 0.0;  // would cut off an empty interval or a sliver
     }
   }
   return selected;
@@ -133,7 +134,8 @@ std::vector<Plane> slice_adaptive(const cv::Mat& disparity, const SlicingParams&
   const LevelStats& stats = normalized.stats;
   const std::vector<double> h = slicing_histogram(normalized.levels, p);
   const std::vector<double> t = transition_index(h, p.eps);
-  const std::vector<int> selected = select_transitions(t, h, p.xi, p.threshold, p.max_planes - 1);
+  const std::vector<int> selected = select_transitions(t, h, p.xi, p.threshold, p.max_planes - 1,
+                                                         p.min_plane_share / p.max_planes);
   const std::vector<int> b = plane_boundaries(selected, stats.count);
   std::vector<Plane> planes;
   for (size_t j = 0; j + 1 < b.size(); ++j) planes.push_back(plane_for_interval(stats, b[j], b[j + 1], p.range));

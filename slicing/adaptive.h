@@ -27,6 +27,11 @@ struct SlicingParams {
   double eps = 0.001;         // floor of h in the transition index's denominator
   int xi = 8;                 // a chosen transition suppresses t in [i - xi, i + xi]
   double threshold = 0.1;     // transitions need t above this
+  // Beyond the paper: every plane must hold more than this fraction of an equal share
+  // (1 / max_planes) of the histogram's mass, so no plane is a sliver of the sparse ends
+  // (select_transitions' min_mass). 0 gives the paper's algorithm, which only refuses
+  // to cut off an empty interval.
+  double min_plane_share = 0.5;
   int bilateral_diameter = 5;           // pixel neighbourhood of the bilateral filter
   double bilateral_sigma_color = 20.0;  // in disparity levels
   double bilateral_sigma_space = 3.0;   // in pixels
@@ -68,11 +73,15 @@ std::vector<double> transition_index(const std::vector<double>& h, double eps);
 // Greedy selection: repeatedly take the largest t_i (the lowest i among equals), store
 // i and zero t in [i - xi, i + xi], until no t_i exceeds threshold or max_selected are
 // stored. The end bins are not candidates (they are always boundaries). One guard beyond
-// the paper: a candidate that would cut off an interval holding no mass of h is dropped
-// (only its own t is zeroed) because it would only make an empty plane; so the count
-// limit counts planes that hold pixels. Returns the indices in the order chosen.
+// the paper: a candidate that would leave an interval on either side of it holding no
+// more than min_mass of h is dropped (only its own t is zeroed). With min_mass 0 that
+// refuses only empty planes. Larger values matter because t = laplacian(h) / h is
+// largest where h is smallest: on a smooth depth map the paper's rule cuts first at the
+// sparse ends, leaving slivers of a few hundred pixels while one plane spans most of
+// the disparity range (bench/RESULTS-slicing.md). The count limit counts planes that
+// pass the guard. Returns the indices in the order chosen.
 std::vector<int> select_transitions(const std::vector<double>& t, const std::vector<double>& h,
-                                    int xi, double threshold, int max_selected);
+                                    int xi, double threshold, int max_selected, double min_mass = 0.0);
 
 // Sorted boundaries {0, selected..., 255}, then every interval holding no pixel of
 // `bin_counts` merged into its lower neighbour (the upper one for the first interval).

@@ -105,6 +105,36 @@ TEST_CASE("select_transitions drops a candidate that would cut off an empty inte
   CHECK(select_transitions(t, h, 0, 0.1, 10) == std::vector<int>{3});
 }
 
+TEST_CASE("select_transitions with min_mass drops a candidate that would leave a sliver") {
+  // Two dense clusters with a gap between them, and sparse ends: every edge of a
+  // populated run has a large transition index, the ones by the sparse ends included.
+  std::vector<double> h(kDisparityLevels, 0.0);
+  for (int i = 5; i <= 12; ++i) h[i] = h[240 + i] = 0.02;
+  for (int i = 30; i <= 120; ++i) h[i] = 1.0;
+  for (int i = 140; i <= 225; ++i) h[i] = 1.0;
+  const double total = std::accumulate(h.begin(), h.end(), 0.0);
+  for (double& v : h) v /= total;
+  const std::vector<double> t = transition_index(h, 0.001);
+  auto smallest_plane = [&](std::vector<int> cuts) {
+    cuts.push_back(0);
+    cuts.push_back(kDisparityLevels);  // the top interval holds the last bin
+    std::sort(cuts.begin(), cuts.end());
+    double least = 1.0;
+    for (size_t j = 0; j + 1 < cuts.size(); ++j)
+      least = std::min(least, std::accumulate(h.begin() + cuts[j], h.begin() + cuts[j + 1], 0.0));
+    return least;
+  };
+  const std::vector<int> paper = select_transitions(t, h, 8, 0.1, 3);
+  REQUIRE(paper.size() == 3);
+  CHECK(smallest_plane(paper) < 0.01);  // the paper's rule cuts off a tail
+  for (double min_mass : {0.05, 0.2}) {
+    const std::vector<int> guarded = select_transitions(t, h, 8, 0.1, 3, min_mass);
+    INFO("min_mass " << min_mass);
+    CHECK(!guarded.empty());
+    CHECK(smallest_plane(guarded) > min_mass);
+  }
+}
+
 TEST_CASE("select_transitions properties on random histograms") {
   for (uint32_t seed = 1; seed <= 40; ++seed) {
     std::mt19937 rng(seed);
@@ -115,10 +145,17 @@ TEST_CASE("select_transitions properties on random histograms") {
     for (double& v : h) v /= total;
     const int xi = static_cast<int>(seed % 12);
     const int max_selected = 1 + static_cast<int>(seed % 9);
+    const double min_mass = 0.02 * (seed % 4);
     const std::vector<double> t = transition_index(h, 0.001);
-    const std::vector<int> s = select_transitions(t, h, xi, 0.1, max_selected);
-    INFO("seed " << seed << ", xi " << xi << ", max " << max_selected);
+    const std::vector<int> s = select_transitions(t, h, xi, 0.1, max_selected, min_mass);
+    INFO("seed " << seed << ", xi " << xi << ", max " << max_selected << ", min_mass " << min_mass);
     CHECK(static_cast<int>(s.size()) <= max_selected);
+    std::vector<int> cuts = s;
+    cuts.push_back(0);
+    cuts.push_back(kDisparityLevels);
+    std::sort(cuts.begin(), cuts.end());
+    for (size_t j = 0; j + 1 < cuts.size(); ++j)  // every plane holds more than min_mass
+      CHECK(std::accumulate(h.begin() + cuts[j], h.begin() + cuts[j + 1], 0.0) > min_mass);
     for (size_t a = 0; a < s.size(); ++a) {
       CHECK(s[a] > 0);
       CHECK(s[a] < kDisparityLevels - 1);
