@@ -373,7 +373,7 @@ int eval_slicing(int argc, char** argv) {
     if (v != "push-pull" && v != "network") throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
     a.inpainter = v;
   });
-  p.option("--min-plane-share", &a.options.min_plane_share, 0.0, 0.99);
+  p.option("--min-plane-share", &a.options.min_plane_share, 0.0, 1.0);
   p.option("--limit", &a.limit, 0, 1 << 30);
   p.option("--threads", &a.threads, 0, 1024);
   if (!p.parse(argc, argv)) return 0;

@@ -101,7 +101,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--working-size", &a.mpi.working_size, kMinPhotoSide, 16384);
   p.option("--max-planes", &a.mpi.slicing.max_planes, 1, kDisparityLevels - 1);
   p.flag("--uniform", &a.mpi.uniform);
-  p.option("--min-plane-share", &a.mpi.slicing.min_plane_share, 0.0, 0.99);
+  p.option("--min-plane-share", &a.mpi.slicing.min_plane_share, 0.0, 1.0);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
   p.option("--inpainter", [&](const std::string& v) {

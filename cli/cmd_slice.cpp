@@ -26,7 +26,7 @@ const char kUsage[] =
     "  --max-planes N        at most N planes (1..255; default 8); with --uniform, exactly\n"
     "                        N equal intervals, of which empty ones are dropped\n"
     "  --min-plane-share F   adaptive cuts leave each plane more than F/N of the depth\n"
-    "                        histogram, N = --max-planes, F in 0..0.99 (default 0.5; 0: the\n"
+    "                        histogram, N = --max-planes, F in 0..1 (default 0.5; 0: the\n"
     "                        paper's rule exactly, which only refuses empty planes)\n"
     "  --uniform             equal disparity intervals (the paper's baseline)\n"
     "  --depth-is-distance   DEPTH holds distances (larger = farther), not disparity\n";
@@ -50,8 +50,8 @@ int parse_plane_count(const char* text) {
 double parse_min_plane_share(const char* text) {
   char* end = nullptr;
   const double f = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(f >= 0 && f <= 0.99))
-    throw std::runtime_error(std::string("--min-plane-share: '") + text + "' is not a number in 0..0.99");
+  if (end == text || *end != '\0' || !(f >= 0 && f <= 1))
+    throw std::runtime_error(std::string("--min-plane-share: '") + text + "' is not a number in 0..1");
   return f;
 }
 

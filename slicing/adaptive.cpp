@@ -20,7 +20,7 @@ void check_params(const SlicingParams& p) {
   require(p.max_planes >= 1 && p.max_planes <= kDisparityLevels - 1, "max_planes must be in 1..255");
   require(p.eps > 0, "eps must be positive");
   require(p.xi >= 0, "xi must not be negative");
-  require(p.min_plane_share >= 0 && p.min_plane_share < 1, "min_plane_share must be in [0, 1)");
+  require(p.min_plane_share >= 0 && p.min_plane_share <= 1, "min_plane_share must be in [0, 1]");
   require(p.bilateral_diameter >= 1, "bilateral_diameter must be at least 1");
   require(p.bilateral_sigma_color > 0 && p.bilateral_sigma_space > 0, "bilateral sigmas must be positive");
   require(p.canny_low >= 0 && p.canny_high >= p.canny_low, "Canny thresholds must satisfy 0 <= low <= high");

@@ -53,7 +53,7 @@ inline float32x4_t activate(float32x4_t x, ActivationSpec a) {
     case Activation::HardSigmoid:
     case Activation::HardSwish: {
       float32x4_t g = vaddq_f32(x, vdupq_n_f32(3.0f));
-      g = vdivq_f32(vminq_f32(vmaxq_f32(g, zero), vdupq_n_f32(6.0f)), vdupq_n_f32(6.0f));
+      g = vmulq_f32(vminq_f32(vmaxq_f32(g, zero), vdupq_n_f32(6.0f)), vdupq_n_f32(kOneSixth));  // no divide (kOneSixth)
       return a.kind == Activation::HardSwish ? vmulq_f32(x, g) : g;
     }
     case Activation::Sigmoid: return sigmoid(x);

@@ -59,7 +59,7 @@ inline __m256 activate(__m256 x, ActivationSpec a) {
     case Activation::HardSwish: {
       __m256 g = _mm256_add_ps(x, _mm256_set1_ps(3.0f));
       g = _mm256_min_ps(_mm256_max_ps(g, zero), _mm256_set1_ps(6.0f));
-      g = _mm256_div_ps(g, _mm256_set1_ps(6.0f));
+      g = _mm256_mul_ps(g, _mm256_set1_ps(kOneSixth));  // no divide (kOneSixth)
       return a.kind == Activation::HardSwish ? _mm256_mul_ps(x, g) : g;
     }
     case Activation::Sigmoid: return sigmoid(x);

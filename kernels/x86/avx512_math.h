@@ -53,7 +53,7 @@ inline __m512 activate(__m512 x, ActivationSpec a) {
     case Activation::HardSwish: {
       __m512 g = _mm512_add_ps(x, _mm512_set1_ps(3.0f));
       g = _mm512_min_ps(_mm512_max_ps(g, zero), _mm512_set1_ps(6.0f));
-      g = _mm512_div_ps(g, _mm512_set1_ps(6.0f));
+      g = _mm512_mul_ps(g, _mm512_set1_ps(kOneSixth));  // no divide (kOneSixth)
       return a.kind == Activation::HardSwish ? _mm512_mul_ps(x, g) : g;
     }
     case Activation::Sigmoid: return sigmoid(x);
