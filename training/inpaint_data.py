@@ -51,6 +51,7 @@ MIN_REMOVED, MIN_KNOWN = 0.02, 0.25  # fractions of a crop a sample needs
 
 # transition selection, as slicing/adaptive.h
 SLICE_EPS, SLICE_XI, SLICE_THRESHOLD, SLICE_MAX_PLANES = 0.001, 8, 0.1, 8
+SLICE_MIN_PLANE_SHARE = 0.5  # slicing/adaptive.h min_plane_share: each plane > 0.5 / 8 of h
 EDGE_GRADIENT, EDGE_BAND = 6.0, 7  # levels per pixel that make an edge; band width
 
 
@@ -140,18 +141,29 @@ def slicing_histogram(levels: np.ndarray) -> np.ndarray:
 
 
 def select_transitions(h: np.ndarray) -> list:
-    """The paper's greedy choice on t = laplacian(h) / max(eps, h)."""
+    """The paper's greedy choice on t = laplacian(h) / max(eps, h), with the C++ slicer's
+    guard (slicing/adaptive.h select_transitions): a candidate that would leave a plane
+    with min_plane_share / max_planes of h or less on either side is dropped."""
     lap = np.zeros_like(h)
     lap[1:-1] = h[:-2] - 2 * h[1:-1] + h[2:]
     t = lap / np.maximum(SLICE_EPS, h)
     t[0] = t[-1] = 0
+    prefix = np.concatenate([[0.0], np.cumsum(h)])
+    min_mass = SLICE_MIN_PLANE_SHARE / SLICE_MAX_PLANES
+    bounds = [0, len(h)]  # interval ends; the top interval holds the last bin
     chosen = []
     while len(chosen) < SLICE_MAX_PLANES - 1:
         i = int(np.argmax(t))
         if t[i] <= SLICE_THRESHOLD:
             break
-        chosen.append(i)
-        t[max(0, i - SLICE_XI):i + SLICE_XI + 1] = 0
+        above = next(b for b in bounds if b > i)
+        below = max(b for b in bounds if b <= i)
+        if prefix[i] - prefix[below] > min_mass and prefix[above] - prefix[i] > min_mass:
+            chosen.append(i)
+            bounds = sorted(bounds + [i])
+            t[max(0, i - SLICE_XI):i + SLICE_XI + 1] = 0
+        else:
+            t[i] = 0
     return sorted(chosen)
 
 

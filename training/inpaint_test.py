@@ -1,13 +1,17 @@
-"""Unit tests of the inpainting network's Python side: the push-pull port and the
-residual generator's starting point. Run: /usr/bin/python3 training/inpaint_test.py"""
+"""Unit tests of the inpainting network's Python side: the push-pull port, the residual
+generator's starting point, the export round trip and the training data's slicing.
+Run: /usr/bin/python3 training/inpaint_test.py"""
 import os
 import sys
+import tempfile
 import unittest
 
 import numpy as np
 import torch
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import export_inpaint  # noqa: E402
+import inpaint_data  # noqa: E402
 import inpaint_model as im  # noqa: E402
 import inpaint_push_pull as pp  # noqa: E402
 
@@ -54,6 +58,46 @@ class ResidualGeneratorTest(unittest.TestCase):
         known = hole.expand_as(rgb) == 0
         self.assertTrue(torch.equal(out[known], rgb[known]))
         self.assertFalse(torch.equal(out[~known], rgb[~known]))
+
+
+class ExportTest(unittest.TestCase):
+    def test_import_inverts_export(self):
+        torch.manual_seed(3)
+        g = im.InpaintGenerator()
+        for p in g.parameters():
+            torch.nn.init.normal_(p, std=0.1)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = os.path.join(tmp, "g.ampw")
+            export_inpaint.export(g, path)
+            back = export_inpaint.import_ampw(path)
+        self.assertEqual(back.residual, g.residual)
+        for (name, a), (_, b) in zip(g.state_dict().items(), back.state_dict().items()):
+            self.assertTrue(torch.equal(a, b), name)
+
+
+class SlicingTest(unittest.TestCase):
+    def test_every_plane_keeps_its_share(self):
+        """The numpy slicer keeps the C++ slicer's guard: each plane above
+        min_plane_share / max_planes of the histogram."""
+        rng = np.random.default_rng(1)
+        least = inpaint_data.SLICE_MIN_PLANE_SHARE / inpaint_data.SLICE_MAX_PLANES
+        for _ in range(10):
+            disparity = np.cumsum(rng.normal(size=(90, 120)), axis=0) + rng.normal(size=(90, 120))
+            h = inpaint_data.slicing_histogram(inpaint_data.normalise_levels(disparity))
+            cuts = [0] + inpaint_data.select_transitions(h) + [len(h)]
+            for lo, hi in zip(cuts, cuts[1:]):
+                self.assertGreater(h[lo:hi].sum(), least)
+
+    def test_a_sparse_end_is_not_cut_off(self):
+        h = np.zeros(256)
+        h[3:6] = 0.001  # a few pixels at the far end
+        h[40:120] = 1.0
+        h[150:230] = 1.0
+        h /= h.sum()
+        cuts = inpaint_data.select_transitions(h)
+        self.assertTrue(any(120 <= c <= 150 for c in cuts))  # the gap between the clusters
+        # The paper's rule alone would also cut at 39, leaving the few far pixels a plane.
+        self.assertTrue(all(h[:c].sum() > 0.01 for c in cuts))
 
 
 if __name__ == "__main__":
