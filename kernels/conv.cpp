@@ -180,6 +180,38 @@ float* im2col_scratch(size_t floats) {
   return buffer.data();
 }
 
+// The input rows one rows-path task reads. With horizontal padding each is copied once
+// between zero columns, into a ring of `span` rows (input row iy in slot iy % span) that
+// consecutive output rows share; without it, the input rows themselves.
+class PaddedRows {
+ public:
+  PaddedRows(const ConvParams& p, const float* in, int in_w, int span)
+      : in_(in), row_floats_(static_cast<int64_t>(in_w) * p.in_c), left_(static_cast<int64_t>(p.pad_left) * p.in_c),
+        right_(static_cast<int64_t>(p.pad_right) * p.in_c), held_(span, -1) {
+    if (left_ > 0 || right_ > 0) ring_ = im2col_scratch(static_cast<size_t>(span * (left_ + row_floats_ + right_)));
+  }
+
+  const float* row(int iy) {
+    const float* src = in_ + iy * row_floats_;
+    if (!ring_) return src;
+    const size_t slot = static_cast<size_t>(iy) % held_.size();
+    float* row = ring_ + static_cast<int64_t>(slot) * (left_ + row_floats_ + right_);
+    if (held_[slot] != iy) {
+      std::fill_n(row, left_, 0.0f);
+      std::copy_n(src, row_floats_, row + left_);
+      std::fill_n(row + left_ + row_floats_, right_, 0.0f);
+      held_[slot] = iy;
+    }
+    return row;
+  }
+
+ private:
+  const float* in_;
+  int64_t row_floats_, left_, right_;
+  std::vector<int> held_;
+  float* ring_ = nullptr;
+};
+
 }  // namespace
 
 int ConvParams::out_h(int in_h) const {
@@ -463,8 +495,6 @@ void Conv2d::run_rows(const float* in, int in_h, int in_w, float* out, const flo
   const int out_h = p_.out_h(in_h), out_w = p_.out_w(in_w), c = p_.in_c, out_c = p_.out_c;
   const int run = rows_run_taps(p_), runs_per_row = p_.kernel_w / run;
   const int span = (p_.kernel_h - 1) * p_.dilation_h + 1;  // input rows one output row reads
-  const bool pad_columns = p_.pad_left > 0 || p_.pad_right > 0;
-  const int64_t padded_floats = static_cast<int64_t>(p_.pad_left + in_w + p_.pad_right) * c;
   const float* bias = packed_.get() + group_stride_ * p_.kernel_h * runs_per_row;
   const int64_t row_values = static_cast<int64_t>(out_w) * out_c;
   GemmArgs base;
@@ -473,22 +503,7 @@ void Conv2d::run_rows(const float* in, int in_h, int in_w, float* out, const flo
   base.a_stride = static_cast<int64_t>(p_.stride_w) * c;
   base.c_stride = out_c;
   pool.parallel_for(out_h, 1, [&](int64_t first, int64_t last) {
-    // With horizontal padding, input rows are copied between zero columns, into a ring of
-    // span rows (input row iy in slot iy % span) so consecutive output rows share them.
-    float* ring = pad_columns ? im2col_scratch(static_cast<size_t>(span * padded_floats)) : nullptr;
-    std::vector<int> held(span, -1);
-    auto padded_row = [&](int iy) -> const float* {
-      const float* src = in + static_cast<int64_t>(iy) * in_w * c;
-      if (!pad_columns) return src;
-      float* row = ring + (iy % span) * padded_floats;
-      if (held[iy % span] != iy) {
-        std::fill_n(row, static_cast<int64_t>(p_.pad_left) * c, 0.0f);
-        std::copy_n(src, static_cast<int64_t>(in_w) * c, row + static_cast<int64_t>(p_.pad_left) * c);
-        std::fill_n(row + static_cast<int64_t>(p_.pad_left + in_w) * c, static_cast<int64_t>(p_.pad_right) * c, 0.0f);
-        held[iy % span] = static_cast<int>(iy);
-      }
-      return row;
-    };
+    PaddedRows padded(p_, in, in_w, span);
     // The bias repeated along a row: the first run's gemm adds it as its residual.
     std::vector<float> bias_row(static_cast<size_t>(row_values));
     for (int x = 0; x < out_w; ++x) std::copy_n(bias, out_c, bias_row.begin() + static_cast<int64_t>(x) * out_c);
@@ -497,7 +512,7 @@ void Conv2d::run_rows(const float* in, int in_h, int in_w, float* out, const flo
     for (int64_t y = first; y < last; ++y) {
       for (int ky = 0; ky < p_.kernel_h; ++ky) {
         const int iy = static_cast<int>(y) * p_.stride_h - p_.pad_top + ky * p_.dilation_h;
-        rows[ky] = iy >= 0 && iy < in_h ? padded_row(iy) : nullptr;  // rows in the padding add nothing
+        rows[ky] = iy >= 0 && iy < in_h ? padded.row(iy) : nullptr;  // rows in the padding add nothing
       }
       float* row_out = out + y * row_values;
       // Each run's gemm adds its product to the output tile (residual = c after the
