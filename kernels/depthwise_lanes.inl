@@ -74,7 +74,8 @@ template <bool kChecked, int K, int S, class Lane, class V>
     for (int kx = 0; kx < K; ++kx) w[kx] = lane.load(d.weights + (static_cast<int64_t>(ky) * K + kx) * c + ch);
 #pragma GCC unroll 32
     for (int j = 0; j < kColumns; ++j) {
-      const V x = column<kChecked>(d, row, ix0 + j, ch, lane);
+      V x = column<kChecked>(d, row, ix0 + j, ch, lane);
+      keep_in_register(x);  // one load per column, not one per tap (avx512_channels.h)
 #pragma GCC unroll 8
       for (int kx = 0; kx < K; ++kx) {
         const int offset = j - kx;  // = i * S for the pixel i reading column j at tap kx

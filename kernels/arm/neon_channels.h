@@ -65,4 +65,8 @@ inline void copy_floats(const float* src, int64_t n, float* dst) {
   if (n % 4) vst1q_f32(dst + n - 4, vld1q_f32(src + n - 4));
 }
 
+// Nothing to do here: avx512_channels.h says why AVX-512 pins loaded vectors.
+template <class V>
+inline void keep_in_register(V&) {}
+
 }  // namespace ampi::neon

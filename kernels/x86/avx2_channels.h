@@ -83,4 +83,8 @@ inline float horizontal_sum(__m256 v) {
   return _mm_cvtss_f32(s);
 }
 
+// Nothing to do here: avx512_channels.h says why AVX-512 pins loaded vectors.
+template <class V>
+inline void keep_in_register(V&) {}
+
 }  // namespace ampi::avx2
