@@ -1,23 +1,29 @@
 // Vector activation functions for NEON (4 floats). Include only from *_neon.cpp files.
-// Same Cephes exp as the x86 variants.
+// exp and exp2_nonpositive evaluate the polynomials of kernels/exp_polynomials.h.
 #pragma once
 #include <arm_neon.h>
 
 #include "kernels/activation.h"
+#include "kernels/exp_polynomials.h"
 
 namespace ampi::neon {
 
+// Horner's rule on coefficients listed highest degree first.
+template <size_t N>
+inline float32x4_t horner(const float (&c)[N], float32x4_t x) {
+  float32x4_t p = vdupq_n_f32(c[0]);
+#pragma GCC unroll 8
+  for (size_t i = 1; i < N; ++i) p = vfmaq_f32(vdupq_n_f32(c[i]), p, x);
+  return p;
+}
+
 inline float32x4_t exp(float32x4_t x) {
-  x = vminq_f32(vmaxq_f32(x, vdupq_n_f32(-87.3f)), vdupq_n_f32(88.3f));
-  const float32x4_t n = vrndnq_f32(vmulq_f32(x, vdupq_n_f32(1.44269504088896341f)));
-  float32x4_t r = vfmsq_f32(x, n, vdupq_n_f32(0.693359375f));
-  r = vfmsq_f32(r, n, vdupq_n_f32(-2.12194440e-4f));
-  float32x4_t p = vdupq_n_f32(1.9875691500e-4f);
-  p = vfmaq_f32(vdupq_n_f32(1.3981999507e-3f), p, r);
-  p = vfmaq_f32(vdupq_n_f32(8.3334519073e-3f), p, r);
-  p = vfmaq_f32(vdupq_n_f32(4.1665795894e-2f), p, r);
-  p = vfmaq_f32(vdupq_n_f32(1.6666665459e-1f), p, r);
-  p = vfmaq_f32(vdupq_n_f32(5.0000001201e-1f), p, r);
+  using namespace exp_poly;
+  x = vminq_f32(vmaxq_f32(x, vdupq_n_f32(kMin)), vdupq_n_f32(kMax));
+  const float32x4_t n = vrndnq_f32(vmulq_f32(x, vdupq_n_f32(kLog2e)));
+  float32x4_t r = vfmsq_f32(x, n, vdupq_n_f32(kLn2Hi));
+  r = vfmsq_f32(r, n, vdupq_n_f32(kLn2Lo));
+  float32x4_t p = horner(kExp, r);
   p = vfmaq_f32(vaddq_f32(r, vdupq_n_f32(1.0f)), p, vmulq_f32(r, r));
   const int32x4_t e = vshlq_n_s32(vaddq_s32(vcvtq_s32_f32(n), vdupq_n_s32(127)), 23);
   return vmulq_f32(p, vreinterpretq_f32_s32(e));
@@ -25,16 +31,9 @@ inline float32x4_t exp(float32x4_t x) {
 
 // 2^y for y <= 0, as in the x86 headers.
 inline float32x4_t exp2_nonpositive(float32x4_t y) {
-  y = vmaxq_f32(y, vdupq_n_f32(-126.0f));
+  y = vmaxq_f32(y, vdupq_n_f32(exp_poly::kExp2Min));
   const float32x4_t n = vrndnq_f32(y);
-  const float32x4_t f = vsubq_f32(y, n);
-  float32x4_t p = vdupq_n_f32(1.540353039e-4f);
-  p = vfmaq_f32(vdupq_n_f32(1.333355815e-3f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(9.618129108e-3f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(5.550410866e-2f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(2.402265070e-1f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(6.931471806e-1f), p, f);
-  p = vfmaq_f32(vdupq_n_f32(1.0f), p, f);
+  const float32x4_t p = horner(exp_poly::kExp2, vsubq_f32(y, n));
   const int32x4_t e = vshlq_n_s32(vaddq_s32(vcvtq_s32_f32(n), vdupq_n_s32(127)), 23);
   return vmulq_f32(p, vreinterpretq_f32_s32(e));
 }

@@ -1,45 +1,42 @@
 // Vector activation functions for AVX2 (8 floats). Include only from *_avx2.cpp files.
-// exp uses the Cephes single-precision polynomial after range reduction to
-// [-ln2/2, ln2/2]; relative error about 2e-7, enough for every epilogue here.
+// exp and exp2_nonpositive evaluate the polynomials of kernels/exp_polynomials.h.
 #pragma once
 #include <immintrin.h>
 
 #include "kernels/activation.h"
+#include "kernels/exp_polynomials.h"
 
 namespace ampi::avx2 {
 
+// Horner's rule on coefficients listed highest degree first.
+template <size_t N>
+inline __m256 horner(const float (&c)[N], __m256 x) {
+  __m256 p = _mm256_set1_ps(c[0]);
+#pragma GCC unroll 8
+  for (size_t i = 1; i < N; ++i) p = _mm256_fmadd_ps(p, x, _mm256_set1_ps(c[i]));
+  return p;
+}
+
 inline __m256 exp(__m256 x) {
-  x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(-87.3f)), _mm256_set1_ps(88.3f));
-  const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(1.44269504088896341f)),
+  using namespace exp_poly;
+  x = _mm256_min_ps(_mm256_max_ps(x, _mm256_set1_ps(kMin)), _mm256_set1_ps(kMax));
+  const __m256 n = _mm256_round_ps(_mm256_mul_ps(x, _mm256_set1_ps(kLog2e)),
                                    _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  __m256 r = _mm256_fnmadd_ps(n, _mm256_set1_ps(0.693359375f), x);
-  r = _mm256_fnmadd_ps(n, _mm256_set1_ps(-2.12194440e-4f), r);
-  __m256 p = _mm256_set1_ps(1.9875691500e-4f);
-  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.3981999507e-3f));
-  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(8.3334519073e-3f));
-  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(4.1665795894e-2f));
-  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(1.6666665459e-1f));
-  p = _mm256_fmadd_ps(p, r, _mm256_set1_ps(5.0000001201e-1f));
+  __m256 r = _mm256_fnmadd_ps(n, _mm256_set1_ps(kLn2Hi), x);
+  r = _mm256_fnmadd_ps(n, _mm256_set1_ps(kLn2Lo), r);
+  __m256 p = horner(kExp, r);
   p = _mm256_fmadd_ps(p, _mm256_mul_ps(r, r), _mm256_add_ps(r, _mm256_set1_ps(1.0f)));
   const __m256i e = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
   return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
 }
 
-// 2^y for y <= 0 (below -126 it returns 2^-126): 2^n times a degree-6 Taylor polynomial
-// of 2^f on f in [-0.5, 0.5], relative error about 1e-7. Cheaper than exp (no clamp from
-// above, no two-part range reduction): the slicer's bilateral weights, where it is
-// the inner loop, use it.
+// 2^y for y <= 0 (below -126 it returns 2^-126). Cheaper than exp (no clamp from above,
+// no two-part range reduction): the slicer's bilateral weights, where it is the inner
+// loop, use it.
 inline __m256 exp2_nonpositive(__m256 y) {
-  y = _mm256_max_ps(y, _mm256_set1_ps(-126.0f));
+  y = _mm256_max_ps(y, _mm256_set1_ps(exp_poly::kExp2Min));
   const __m256 n = _mm256_round_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m256 f = _mm256_sub_ps(y, n);
-  __m256 p = _mm256_set1_ps(1.540353039e-4f);
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(1.333355815e-3f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(9.618129108e-3f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(5.550410866e-2f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(2.402265070e-1f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(6.931471806e-1f));
-  p = _mm256_fmadd_ps(p, f, _mm256_set1_ps(1.0f));
+  const __m256 p = horner(exp_poly::kExp2, _mm256_sub_ps(y, n));
   const __m256i e = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
   return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
 }

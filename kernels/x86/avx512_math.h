@@ -1,40 +1,39 @@
 // Vector activation functions for AVX-512 (16 floats). Include only from *_avx512.cpp.
-// Same Cephes exp as avx2_math.h.
+// exp and exp2_nonpositive evaluate the polynomials of kernels/exp_polynomials.h.
 #pragma once
 #include <immintrin.h>
 
 #include "kernels/activation.h"
+#include "kernels/exp_polynomials.h"
 
 namespace ampi::avx512 {
 
+// Horner's rule on coefficients listed highest degree first.
+template <size_t N>
+inline __m512 horner(const float (&c)[N], __m512 x) {
+  __m512 p = _mm512_set1_ps(c[0]);
+#pragma GCC unroll 8
+  for (size_t i = 1; i < N; ++i) p = _mm512_fmadd_ps(p, x, _mm512_set1_ps(c[i]));
+  return p;
+}
+
 inline __m512 exp(__m512 x) {
-  x = _mm512_min_ps(_mm512_max_ps(x, _mm512_set1_ps(-87.3f)), _mm512_set1_ps(88.3f));
-  const __m512 n = _mm512_roundscale_ps(_mm512_mul_ps(x, _mm512_set1_ps(1.44269504088896341f)),
+  using namespace exp_poly;
+  x = _mm512_min_ps(_mm512_max_ps(x, _mm512_set1_ps(kMin)), _mm512_set1_ps(kMax));
+  const __m512 n = _mm512_roundscale_ps(_mm512_mul_ps(x, _mm512_set1_ps(kLog2e)),
                                         _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  __m512 r = _mm512_fnmadd_ps(n, _mm512_set1_ps(0.693359375f), x);
-  r = _mm512_fnmadd_ps(n, _mm512_set1_ps(-2.12194440e-4f), r);
-  __m512 p = _mm512_set1_ps(1.9875691500e-4f);
-  p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(1.3981999507e-3f));
-  p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(8.3334519073e-3f));
-  p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(4.1665795894e-2f));
-  p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(1.6666665459e-1f));
-  p = _mm512_fmadd_ps(p, r, _mm512_set1_ps(5.0000001201e-1f));
+  __m512 r = _mm512_fnmadd_ps(n, _mm512_set1_ps(kLn2Hi), x);
+  r = _mm512_fnmadd_ps(n, _mm512_set1_ps(kLn2Lo), r);
+  __m512 p = horner(kExp, r);
   p = _mm512_fmadd_ps(p, _mm512_mul_ps(r, r), _mm512_add_ps(r, _mm512_set1_ps(1.0f)));
   return _mm512_scalef_ps(p, n);
 }
 
 // 2^y for y <= 0, as in avx2_math.h; scalef applies 2^n.
 inline __m512 exp2_nonpositive(__m512 y) {
-  y = _mm512_max_ps(y, _mm512_set1_ps(-126.0f));
+  y = _mm512_max_ps(y, _mm512_set1_ps(exp_poly::kExp2Min));
   const __m512 n = _mm512_roundscale_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m512 f = _mm512_sub_ps(y, n);
-  __m512 p = _mm512_set1_ps(1.540353039e-4f);
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(1.333355815e-3f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(9.618129108e-3f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(5.550410866e-2f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(2.402265070e-1f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(6.931471806e-1f));
-  p = _mm512_fmadd_ps(p, f, _mm512_set1_ps(1.0f));
+  const __m512 p = horner(exp_poly::kExp2, _mm512_sub_ps(y, n));
   return _mm512_scalef_ps(p, n);
 }
 
