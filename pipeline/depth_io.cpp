@@ -58,6 +58,7 @@ void check_decoded_size(const std::string& path, const std::vector<unsigned char
 
 cv::Mat decode_image(const std::string& path) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
+  refuse_dicom(path, bytes);
   check_png_complete(path, bytes);
   check_decoded_size(path, bytes);
   cv::Mat image;

@@ -110,8 +110,15 @@ std::optional<EncodedImageSize> encoded_image_size(const std::vector<unsigned ch
   return std::nullopt;
 }
 
+void refuse_dicom(const std::string& path, const std::vector<unsigned char>& bytes) {
+  constexpr size_t kDicomMagicAt = 128;
+  if (bytes.size() >= kDicomMagicAt + 4 && std::memcmp(&bytes[kDicomMagicAt], "DICM", 4) == 0)
+    fail(path, "DICOM files are not supported");
+}
+
 cv::Mat read_photo(const std::string& path) {
   const std::vector<unsigned char> bytes = read_file_bytes(path);
+  refuse_dicom(path, bytes);
   check_not_truncated(path, bytes);
   check_decoded_size(path, bytes);
   cv::Mat image;

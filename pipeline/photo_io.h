@@ -21,6 +21,11 @@ struct EncodedImageSize {
 };
 std::optional<EncodedImageSize> encoded_image_size(const std::vector<unsigned char>& bytes);
 
+// Throws std::runtime_error "PATH: DICOM files are not supported" for bytes OpenCV would
+// hand to its DICOM decoder ("DICM" at byte 128): GDCM aborts the whole process on some
+// malformed DICOM files (fuzz_depth_map found one), and no photo or depth map is one.
+void refuse_dicom(const std::string& path, const std::vector<unsigned char>& bytes);
+
 // Reads a photo as 8-bit BGR with its EXIF orientation applied. Grayscale, 16-bit,
 // alpha (dropped) and CMYK inputs are converted. Throws std::runtime_error
 // "PATH: problem" for a missing path, a directory, an unreadable, empty, truncated or

@@ -112,12 +112,15 @@ TEST_CASE("read_photo rejects bad input with one line naming the file") {
   write_bytes(dir / "cut.jpg", std::vector<unsigned char>(jpg.begin(), jpg.begin() + jpg.size() / 2));
   write_bytes(dir / "cut.png", std::vector<unsigned char>(png.begin(), png.begin() + png.size() / 2));
   write_bytes(dir / "tiny.png", encode(test_image(8, 40), ".png"));
+  std::vector<unsigned char> dicom(128, 0);  // OpenCV's DICOM decoder (GDCM) aborts on some
+  for (char c : std::string("DICM") + std::string(64, '\xff')) dicom.push_back(static_cast<unsigned char>(c));
+  write_bytes(dir / "scan.jpg", dicom);
   fs::create_directories(dir / "folder.jpg");
   const std::pair<const char*, const char*> cases[] = {
       {"missing.jpg", "no such file"},        {"empty.jpg", "empty file"},
       {"text.jpg", "not a readable image"},   {"cut.jpg", "truncated JPEG"},
       {"cut.png", "truncated PNG"},           {"folder.jpg", "is a directory"},
-      {"tiny.png", "at least 16 px"},
+      {"tiny.png", "at least 16 px"},         {"scan.jpg", "DICOM files are not supported"},
   };
   for (const auto& [name, problem] : cases) {
     const std::string path = (dir / name).string();

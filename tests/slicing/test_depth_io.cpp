@@ -130,6 +130,10 @@ TEST_CASE("missing, empty and unreadable depth files give one-line errors") {
   REQUIRE(cv::imencode(".png", cv::Mat(64, 64, CV_16UC1, cv::Scalar(1234)), png));
   png.resize(png.size() - 12);
   std::ofstream(dir / "cut.png", std::ios::binary).write(reinterpret_cast<const char*>(png.data()), png.size());
+  std::string dicom(128, '\0');  // OpenCV's DICOM decoder (GDCM) aborts on some such files
+  dicom += "DICM";
+  dicom += std::string(64, '\xff');
+  write_text(dir / "scan.png", dicom);
   const struct {
     std::string path, problem;
   } cases[] = {{dir / "missing.png", "no such file"},
@@ -137,7 +141,8 @@ TEST_CASE("missing, empty and unreadable depth files give one-line errors") {
                {dir / "empty.png", "empty file"},
                {dir / "text.png", "not a readable image"},
                {dir / "text.npy", "not a .npy file"},
-               {dir / "cut.png", "truncated PNG"}};
+               {dir / "cut.png", "truncated PNG"},
+               {dir / "scan.png", "DICOM files are not supported"}};
   for (const auto& c : cases) {
     INFO(c.path);
     const std::string message = import_error(c.path);
