@@ -7,7 +7,9 @@
 depth: 50 synthetic validation scenes (training/make_eval_scenes.py: exact disparity,
 textured with validation photos only), `ampi eval depth` with the lite and the heavy
 network. slicing: the validation photos (every tenth photo by sorted name of each folder
-of ../shared/data/photos, training/scenes.py photo_split), `ampi eval slicing`.
+of ../shared/data/photos, training/scenes.py photo_split), `ampi eval slicing` with the
+default plane guard and with the paper's rule exactly; the guard's tuning runs on
+training photos; the same on 50 synthetic scenes with their exact depth.
 The tables quote ampi's output verbatim, with the command that made it.
 """
 
