@@ -2,6 +2,7 @@
 
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace ampi {
@@ -40,12 +41,16 @@ cv::Mat pull(const Level& level, const cv::Mat& coarse_estimate) {
   return level.colour + up.mul(rest3);
 }
 
+void check_fill_inputs(const char* who, const cv::Mat& image, const cv::Mat& known) {
+  if ((image.type() != CV_8UC3 && image.type() != CV_8UC4) || known.type() != CV_8UC1 ||
+      known.size() != image.size())
+    throw std::invalid_argument(std::string(who) + ": expects 8-bit BGR(A) image and 8-bit masks of its size");
+}
+
 }  // namespace
 
-cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill) {
-  if ((image.type() != CV_8UC3 && image.type() != CV_8UC4) || known.type() != CV_8UC1 ||
-      fill.type() != CV_8UC1 || known.size() != image.size() || fill.size() != image.size())
-    throw std::invalid_argument("push_pull_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+cv::Mat push_pull_estimate(const cv::Mat& image, const cv::Mat& known) {
+  check_fill_inputs("push_pull_estimate", image, known);
   cv::Mat bgr;
   if (image.channels() == 4)
     cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
@@ -55,18 +60,22 @@ cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat
   std::vector<Level> pyramid(1);
   known.convertTo(pyramid[0].weight, CV_32F, 1.0 / 255.0);
   cv::threshold(pyramid[0].weight, pyramid[0].weight, 0.0, 1.0, cv::THRESH_BINARY);
+  if (cv::countNonZero(pyramid[0].weight) == 0) return cv::Mat();  // nothing to spread
   cv::Mat weight3;
   cv::merge(std::vector<cv::Mat>(3, pyramid[0].weight), weight3);
   bgr.convertTo(pyramid[0].colour, CV_32F);
   pyramid[0].colour = pyramid[0].colour.mul(weight3);
-  if (cv::countNonZero(pyramid[0].weight) == 0) return image.clone();  // nothing to spread
   while (pyramid.back().weight.cols > 1 || pyramid.back().weight.rows > 1)
     pyramid.push_back(push(pyramid.back()));
 
   // The coarsest cell has full confidence once any pixel is known.
   cv::Mat estimate = pyramid.back().colour / std::max(1e-12, double(pyramid.back().weight.at<float>(0, 0)));
   for (size_t l = pyramid.size() - 1; l-- > 0;) estimate = pull(pyramid[l], estimate);
+  return estimate;
+}
 
+cv::Mat paste_estimate(const cv::Mat& image, const cv::Mat& estimate, const cv::Mat& fill) {
+  CV_Assert(estimate.type() == CV_32FC3 && estimate.size() == image.size() && fill.size() == image.size());
   cv::Mat filled_bgr;
   estimate.convertTo(filled_bgr, CV_8U);
   cv::Mat out = image.clone();
@@ -80,6 +89,14 @@ cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat
     cv::merge(channels, out);
   }
   return out;
+}
+
+cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill) {
+  check_fill_inputs("push_pull_fill", image, known);
+  if (fill.type() != CV_8UC1 || fill.size() != image.size())
+    throw std::invalid_argument("push_pull_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+  const cv::Mat estimate = push_pull_estimate(image, known);
+  return estimate.empty() ? image.clone() : paste_estimate(image, estimate, fill);
 }
 
 }  // namespace ampi

@@ -13,4 +13,12 @@ namespace ampi {
 // fill != 0 are replaced by the push-pull estimate; every other pixel is unchanged.
 cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill);
 
+// The float estimate behind push_pull_fill: CV_32FC3 at every pixel (the known colour
+// where known), from an 8-bit BGR(A) image. Empty when no pixel is known.
+cv::Mat push_pull_estimate(const cv::Mat& image, const cv::Mat& known);
+
+// A copy of image (CV_8UC3 or CV_8UC4) whose colour channels take the 8-bit rounding of
+// estimate (CV_32FC3) where fill != 0; alpha and every other pixel are unchanged.
+cv::Mat paste_estimate(const cv::Mat& image, const cv::Mat& estimate, const cv::Mat& fill);
+
 }  // namespace ampi
