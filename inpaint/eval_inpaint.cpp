@@ -7,6 +7,7 @@
 #include <opencv2/imgproc.hpp>
 #include <opencv2/photo.hpp>
 
+#include "inpaint/harmonic_fill.h"
 #include "inpaint/push_pull.h"
 
 namespace ampi {
@@ -122,6 +123,10 @@ MarginFiller navier_stokes_filler(double radius) { return opencv_filler(radius, 
 
 MarginFiller push_pull_margin_filler() {
   return [](const cv::Mat& visible, const MarginSample& s) { return push_pull_fill(visible, s.known, s.removed); };
+}
+
+MarginFiller harmonic_margin_filler() {
+  return [](const cv::Mat& visible, const MarginSample& s) { return harmonic_fill(visible, s.known, s.removed); };
 }
 
 }  // namespace ampi

@@ -67,10 +67,12 @@ class InpaintEvaluator {
   std::vector<MethodScore> sums_;
 };
 
-// The classic fillers: OpenCV's cv::inpaint (Telea, Navier-Stokes) with `radius`, and
-// push-pull (inpaint/push_pull.h).
+// The classic fillers: OpenCV's cv::inpaint (Telea, Navier-Stokes) with `radius`,
+// push-pull (inpaint/push_pull.h) and the harmonic fill (inpaint/harmonic_fill.h), the
+// two prefills a network may refine.
 MarginFiller telea_filler(double radius);
 MarginFiller navier_stokes_filler(double radius);
 MarginFiller push_pull_margin_filler();
+MarginFiller harmonic_margin_filler();
 
 }  // namespace ampi

@@ -7,6 +7,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "inpaint/harmonic_fill.h"
 #include "inpaint/push_pull.h"
 #include "kernels/ops.h"
 
@@ -15,8 +16,7 @@ namespace {
 
 const char* const kModelName = "ampi-inpaint";
 constexpr int64_t kPlainVersion = 1;     // hole zeroed, output = tanh(last)
-constexpr int64_t kResidualVersion = 2;  // hole pre-filled by push-pull, output = rgb + hole * tanh(last)
-const char* const kPrefill = "push-pull";
+constexpr int64_t kResidualVersion = 2;  // hole pre-filled (inpaint.prefill), output = rgb + hole * tanh(last)
 
 [[noreturn]] void fail(const WeightFile& f, const std::string& problem) {
   throw std::runtime_error(f.path() + ": " + problem);
@@ -68,6 +68,13 @@ std::vector<InpaintLayer> read_graph(const WeightFile& f) {
     l.gated = cols[8][i] != 0;
   }
   return layers;
+}
+
+Prefill prefill_from_name(const WeightFile& f) {
+  const std::string name = f.get_string("inpaint.prefill");
+  if (name == "push-pull") return Prefill::PushPull;
+  if (name == "harmonic") return Prefill::Harmonic;
+  fail(f, "inpaint.prefill '" + name + "' is not 'push-pull' or 'harmonic'");
 }
 
 bool refers_back(int ref, size_t i, bool may_be_none) {
@@ -130,10 +137,8 @@ InpaintNet InpaintNet::from_file(const WeightFile& f, const KernelTable& k) {
   const int64_t version = f.get_int("inpaint.version");
   if (version != kPlainVersion && version != kResidualVersion)
     fail(f, "inpaint.version " + std::to_string(version) + " is not supported");
-  if (version == kResidualVersion && f.get_string("inpaint.prefill") != kPrefill)
-    fail(f, "inpaint.prefill '" + f.get_string("inpaint.prefill") + "' is not '" + kPrefill + "'");
   InpaintNet net;
-  net.residual_ = version == kResidualVersion;
+  if (version == kResidualVersion) net.prefill_ = prefill_from_name(f);
   net.k_ = &k;
   net.multiple_ = int(f.get_int("inpaint.multiple"));
   if (net.multiple_ < 1 || net.multiple_ > 64 || (net.multiple_ & (net.multiple_ - 1)))
@@ -172,7 +177,7 @@ void InpaintNet::run(const float* rgb, const float* hole, int h, int w, float* o
   const int64_t pixels = int64_t(h) * w;
   std::vector<float> x(pixels * kInChannels);
   for (int64_t p = 0; p < pixels; ++p) {
-    const float keep = residual_ ? 1.0f : 1.0f - hole[p];
+    const float keep = prefill_ != Prefill::None ? 1.0f : 1.0f - hole[p];
     for (int c = 0; c < 3; ++c) x[p * kInChannels + c] = rgb[p * 3 + c] * keep;
     x[p * kInChannels + 3] = hole[p];
   }
@@ -200,7 +205,7 @@ void InpaintNet::run(const float* rgb, const float* hole, int h, int w, float* o
     for (int ref : {l.source, l.skip})
       if (ref >= 0 && last_use_[ref] == int(i)) std::vector<float>().swap(outs[ref]);
   }
-  if (residual_)  // the tanh output is a correction of the pre-filled hole
+  if (prefill_ != Prefill::None)  // the tanh output is a correction of the pre-filled hole
     for (int64_t p = 0; p < pixels; ++p)
       for (int c = 0; c < 3; ++c) out[p * 3 + c] = rgb[p * 3 + c] + hole[p] * out[p * 3 + c];
 }
@@ -292,6 +297,16 @@ void fill_core(const InpaintNet& net, const cv::Mat& image, const cv::Mat& known
   }
 }
 
+// The network's input colour: its prefill in every unknown pixel.
+cv::Mat prefilled(Prefill prefill, const cv::Mat& image, const cv::Mat& known, ThreadPool& pool) {
+  switch (prefill) {
+    case Prefill::PushPull: return push_pull_fill(image, known, known == 0);
+    case Prefill::Harmonic: return harmonic_fill(image, known, known == 0, {}, pool);
+    case Prefill::None: break;
+  }
+  return image;
+}
+
 }  // namespace
 
 cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat& known,
@@ -305,8 +320,7 @@ cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat
   std::vector<cv::Point> points;
   cv::findNonZero(fill, points);
   if (points.empty()) return result;
-  // the network's input colour: push-pull in every unknown pixel for a version-2 net
-  const cv::Mat source = net.prefills_push_pull() ? push_pull_fill(image, known, known == 0) : image;
+  const cv::Mat source = prefilled(net.prefill(), image, known, pool);
   const cv::Rect box = cv::boundingRect(points);
   for (int y = box.y; y < box.br().y; y += tiling.core)
     for (int x = box.x; x < box.br().x; x += tiling.core) {

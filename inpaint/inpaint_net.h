@@ -9,9 +9,10 @@
 //
 // Two input/output conventions, by the file's inpaint.version:
 //   1  input [rgb with the hole zeroed, hole], output tanh(last): the fill itself;
-//   2  the hole arrives pre-filled by push-pull (inpaint/push_pull.h, what the network
-//      trained on), input [rgb, hole], output rgb + hole * tanh(last): a learned
-//      correction of push-pull inside the hole. inpaint_layer does the pre-fill.
+//   2  the hole arrives pre-filled by the classic fill named in inpaint.prefill (the one
+//      the network trained on): "push-pull" (inpaint/push_pull.h) or "harmonic"
+//      (inpaint/harmonic_fill.h); input [rgb, hole], output rgb + hole * tanh(last): a
+//      learned correction of that fill inside the hole. inpaint_layer does the pre-fill.
 #pragma once
 #include <memory>
 #include <string>
@@ -40,6 +41,9 @@ struct InpaintLayer {
   int scale_log2 = 0;  // its output is 1 / 2^scale_log2 of the input's size
 };
 
+// What fills the hole before the network sees it.
+enum class Prefill { None, PushPull, Harmonic };
+
 class InpaintNet {
  public:
   static constexpr int kInChannels = 4;  // rgb with the hole zeroed, hole
@@ -50,7 +54,7 @@ class InpaintNet {
   static InpaintNet load(const std::string& path, const KernelTable& k = kernels());
   static InpaintNet from_file(const WeightFile& file, const KernelTable& k = kernels());
 
-  // rgb [h][w][3] in [-1, 1] (push-pull in the hole when prefills_push_pull()), hole
+  // rgb [h][w][3] in [-1, 1] (the prefill in the hole unless prefill() is None), hole
   // [h][w] (1 = unknown, 0 = known); h and w multiples of multiple(). out [h][w][3]: the
   // prediction at every pixel (the caller keeps its known pixels). Scratch memory: a few
   // dozen floats per pixel, freed on return.
@@ -58,8 +62,8 @@ class InpaintNet {
            ThreadPool& pool = default_pool()) const;
 
   int multiple() const { return multiple_; }
-  // Version 2: the hole must hold push-pull's fill, and the output is a residual on it.
-  bool prefills_push_pull() const { return residual_; }
+  // Version 2: the hole must hold this fill, and the output is a residual on it.
+  Prefill prefill() const { return prefill_; }
   const std::vector<InpaintLayer>& layers() const { return layers_; }
   // Multiply-adds per input pixel (for benchmarks and the model card).
   double macs_per_pixel() const;
@@ -75,7 +79,7 @@ class InpaintNet {
   std::vector<int> last_use_;  // index of the last layer reading each layer's output
   ActivationSpec feature_act_;
   int multiple_ = 4;
-  bool residual_ = false;
+  Prefill prefill_ = Prefill::None;  // None: version 1, the hole zeroed
   const KernelTable* k_ = nullptr;
 };
 
@@ -92,7 +96,7 @@ struct InpaintTiling {
 
 // Fills `fill` pixels of a BGRA layer with the network's prediction from the `known`
 // pixels (everything not known is the network's hole); every other pixel is unchanged.
-// For a version-2 network, push-pull first fills every unknown pixel of the whole image
+// For a version-2 network, its prefill first fills every unknown pixel of the whole image
 // (one pass, like push_pull_filler), then the windows read from that.
 cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat& known,
                       const cv::Mat& fill, const InpaintTiling& tiling = {},

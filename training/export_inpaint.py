@@ -3,7 +3,7 @@ parity fixtures the C++ tests compare against.
 
 File contents (read by inpaint/inpaint_net.cpp):
   metadata  model = "ampi-inpaint", inpaint.version (1: hole zeroed, output the fill;
-            2: hole pre-filled by push-pull, named in inpaint.prefill, output a residual
+            2: hole pre-filled by the fill named in inpaint.prefill, output a residual
             on it inside the hole; training/inpaint_model.py), the graph of
             training/inpaint_model.py as parallel int arrays (inpaint.source, .upsample,
             .skip, .in_channels, .out_channels, .kernel, .stride, .dilation, .gated),
@@ -18,9 +18,11 @@ Fixtures (tests/fixtures/inpaint/):
   bad_*.ampw, no_tensors.ampw  metadata-only files the loader must reject;
   tiny.ampw + tiny_case.ampw   the same graph with fewer channels and seeded random
                                weights, and one input/output pair from PyTorch;
+  tiny_push_pull.ampw          tiny.ampw naming the push-pull prefill;
   bundled_case.ampw            an input/output pair for the exported weights themselves;
-  push_pull_*.ampw             images, masks and training/inpaint_push_pull.py's fill,
-                               for the C++ push-pull to match.
+  push_pull_*.ampw,            images, masks and training/inpaint_push_pull.py's fill,
+  harmonic_*.ampw              for the C++ push-pull and harmonic fill to match (the
+                               cascade ones name their coarsest_side).
 A case file holds rgb [h][w][3] in [-1, 1], hole [h][w] in {0, 1} and expected [h][w][3].
 
     /usr/bin/python3 training/export_inpaint.py --checkpoint training/runs/inpaint/best.pt
@@ -53,16 +55,15 @@ def narrow_layers(layers, divisor: int):
             for i, row in enumerate(layers)]
 
 
-def graph_metadata(layers, version: int = 2):
+def graph_metadata(layers, version: int = 2, prefill: str = im.PREFILL):
     names = [row[0] for row in layers]
     if any("," in n for n in names):
         raise ValueError("layer names may not contain commas")
     cols = list(zip(*layers))
-    prefill = {"inpaint.prefill": im.PREFILL} if version == 2 else {}
     return {
         "model": "ampi-inpaint",
         "inpaint.version": version,
-        **prefill,
+        **({"inpaint.prefill": prefill} if version == 2 else {}),
         "inpaint.layer_names": ",".join(names),
         "inpaint.source": list(cols[1]),
         "inpaint.upsample": list(cols[2]),
@@ -76,7 +77,7 @@ def graph_metadata(layers, version: int = 2):
         "inpaint.feature_activation": im.FEATURE_ACTIVATION,
         "inpaint.output_activation": im.OUTPUT_ACTIVATION,
         "inpaint.multiple": im.MULTIPLE,
-        "inpaint.input": ("rgb/127.5-1 with push-pull in the hole, then the hole mask (1 = unknown)"
+        "inpaint.input": (f"rgb/127.5-1 with the {prefill} fill in the hole, then the hole mask (1 = unknown)"
                           if version == 2 else
                           "rgb/127.5-1 with the hole zeroed, then the hole mask (1 = unknown)"),
     }
@@ -110,8 +111,8 @@ def import_ampw(path: str) -> im.InpaintGenerator:
     return g
 
 
-def export(g: im.InpaintGenerator, path: str, extra_metadata=None):
-    meta = graph_metadata(g.layers_spec, g.version)
+def export(g: im.InpaintGenerator, path: str, extra_metadata=None, prefill: str = im.PREFILL):
+    meta = graph_metadata(g.layers_spec, g.version, prefill)
     meta.update(extra_metadata or {})
     write_ampw(path, generator_tensors(g), meta)
 
@@ -145,15 +146,23 @@ def write_tiny_fixture():
         torch.nn.init.normal_(g.convs[-1].bias, std=0.1)
         for p in g.parameters():
             p.mul_(2.0)
-    export(g, os.path.join(FIXTURES, "tiny.ampw"), {"training.source": "seeded random weights (fixture)"})
+    source = {"training.source": "seeded random weights (fixture)"}
+    export(g, os.path.join(FIXTURES, "tiny.ampw"), source)
+    export(g, os.path.join(FIXTURES, "tiny_push_pull.ampw"), source, prefill="push-pull")
     write_case(g, os.path.join(FIXTURES, "tiny_case.ampw"), seed=11)
 
 
-def write_push_pull_fixtures():
-    """Odd, even and tiny sizes: INTER_AREA's fractional cells and the 1-pixel levels."""
-    for name, seed, h, w in (("push_pull_odd", 21, 37, 53), ("push_pull_even", 22, 64, 48),
-                             ("push_pull_thin", 23, 5, 19)):
-        inpaint_push_pull.write_fixture(os.path.join(FIXTURES, name + ".ampw"), seed, h, w)
+def write_prefill_fixtures():
+    """Both prefills at odd, even and tiny sizes: INTER_AREA's fractional cells, the
+    1-pixel levels, the relaxation's image edges; and the harmonic cascade, which real
+    photos take above 1024 px, on small images through a small coarsest side."""
+    for method in inpaint_push_pull.PREFILLS:
+        for size, seed, h, w in (("odd", 21, 37, 53), ("even", 22, 64, 48), ("thin", 23, 5, 19)):
+            name = f"{method.replace('-', '_')}_{size}.ampw"
+            inpaint_push_pull.write_fixture(os.path.join(FIXTURES, name), seed, h, w, method)
+    for size, seed, h, w in (("odd", 24, 37, 53), ("even", 25, 64, 48)):
+        inpaint_push_pull.write_fixture(os.path.join(FIXTURES, f"harmonic_cascade_{size}.ampw"), seed, h, w,
+                                        "harmonic", coarsest_side=12, band=3)
 
 
 def write_bad_fixtures():
@@ -178,13 +187,14 @@ def main(argv=None):
     os.makedirs(FIXTURES, exist_ok=True)
     write_tiny_fixture()
     write_bad_fixtures()
-    write_push_pull_fixtures()
+    write_prefill_fixtures()
     if args.tiny_only:
         return 0
     ck = torch.load(args.checkpoint, map_location="cpu")
     g = im.InpaintGenerator(residual=ck.get("residual", False))  # the first runs had none
     g.load_state_dict(ck["generator"])
-    export(g, args.out, {
+    # checkpoints name the prefill they trained on; those from before v5 had push-pull
+    export(g, args.out, prefill=ck.get("prefill", "push-pull"), extra_metadata={
         "training.steps": int(ck["step"]),
         "training.val_psnr": float(ck.get("val_psnr", ck.get("best_psnr", float("nan")))),
         "training.disparity": args.disparity,

@@ -39,7 +39,8 @@ import torch.nn.functional as F
 from PIL import Image, ImageOps
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from inpaint_push_pull import push_pull_fill  # noqa: E402
+from inpaint_model import PREFILL  # noqa: E402
+from inpaint_push_pull import PREFILLS  # noqa: E402
 
 PHOTO_EXTENSIONS = (".jpg", ".jpeg", ".png")
 DEFAULT_PHOTOS = os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data", "photos")
@@ -229,7 +230,7 @@ def contour_pixels(region: np.ndarray) -> np.ndarray:
 def make_sample(photo: Photo, rng: np.random.Generator, crop: int, erode_iterations: int):
     """One training example as float tensors (rgb [3, c, c] in [-1, 1], hole [1, c, c],
     removed [1, c, c], prefilled [3, c, c]: rgb with every hole pixel replaced by the 8-bit
-    push-pull fill from the known ones, what the C++ filler feeds the network), or None
+    PREFILL fill from the known ones, what the C++ filler feeds the network), or None
     when this draw has nothing to inpaint."""
     h, w = photo.labels.shape
     if photo.planes < 2 or h < crop or w < crop:
@@ -260,7 +261,7 @@ def make_sample(photo: Photo, rng: np.random.Generator, crop: int, erode_iterati
         image, hole, removed = image[:, ::-1], hole.flip(-1), removed.flip(-1)
     image = np.ascontiguousarray(image)
     known = hole.numpy() < 0.5
-    prefilled = push_pull_fill(image, known, ~known)
+    prefilled = PREFILLS[PREFILL](image, known, ~known)
     as_tensor = lambda a: torch.from_numpy(a).permute(2, 0, 1).float() / 127.5 - 1.0  # noqa: E731
     return as_tensor(image), hole[None], removed[None], as_tensor(prefilled)
 

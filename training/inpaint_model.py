@@ -11,15 +11,16 @@ field to about 150 px (the MPI margins are about 40 px wide), nearest up-samplin
 it back, with one skip at 1/2 resolution and the input itself fed to the last stage so
 the known border stays sharp.
 
-Version 2 (the default, PREFILL = "push-pull"): the network refines a classic fill
-instead of starting from nothing. The caller fills every hole pixel with push-pull
-(training/inpaint_push_pull.py, the same algorithm as inpaint/push_pull.cpp) first;
+Version 2 (the default): the network refines a classic fill instead of starting from
+nothing. The caller fills every hole pixel with the fill named PREFILL first: "harmonic"
+(membrane interpolation started from push-pull, inpaint/harmonic_fill.h) since v5,
+"push-pull" before (training/inpaint_push_pull.py ports both from the C++);
 
-    input  = [rgb, hole]                    rgb in [-1, 1], push-pull in the hole
+    input  = [rgb, hole]                    rgb in [-1, 1], the prefill in the hole
     output = rgb + hole * tanh(...)         a learned residual, only inside the hole
 
-and the last layer starts at zero, so an untrained network returns push-pull exactly and
-training starts from push-pull's quality. Version 1 (residual=False, the first bundled
+and the last layer starts at zero, so an untrained network returns the prefill exactly
+and training starts from its quality. Version 1 (residual=False, the first bundled
 weights): input [rgb * (1 - hole), hole], output tanh(...).
 
 "hole" is every pixel the network may not look at: at inference everything of the layer
@@ -42,7 +43,7 @@ NO_SKIP = -2  # a layer's skip: none
 FEATURE_ACTIVATION = "elu"  # of the gated layers' feature half (alpha 1)
 OUTPUT_ACTIVATION = "tanh"
 MULTIPLE = 4  # input height and width must be multiples of this (two stride-2 layers)
-PREFILL = "push-pull"  # what fills the hole before a version-2 (residual) network sees it
+PREFILL = "harmonic"  # what fills the hole before a version-2 (residual) network sees it
 
 # One row per layer: (name, source, upsample, skip, out_channels, kernel, stride, dilation,
 # gated). The layer reads layer `source`'s output (INPUT: the network input), up-sampled

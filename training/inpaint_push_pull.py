@@ -101,7 +101,7 @@ def push_pull_float(rgb: np.ndarray, known: np.ndarray) -> np.ndarray:
     return estimate
 
 
-def push_pull_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray) -> np.ndarray:
+def push_pull_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray, **_params) -> np.ndarray:
     """As ampi::push_pull_fill: image uint8 [H, W, 3]; the pixels where fill is set take the
     8-bit push-pull estimate from the known pixels, every other pixel is unchanged."""
     estimate = push_pull_float(image, known)
@@ -113,9 +113,104 @@ def push_pull_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray) -> np
     return out
 
 
-def write_fixture(path: str, seed: int, height: int, width: int):
-    """A random image with a blob, a band and scattered known pixels, and its fill, for the
-    C++ parity test (image, known, fill and expected as float tensors)."""
+# inpaint/harmonic_fill.h HarmonicFill and kKnownShare
+HARMONIC_COARSEST_SIDE, HARMONIC_COARSEST_SWEEPS, HARMONIC_SWEEPS, HARMONIC_BAND = 256, 100, 25, 48
+HARMONIC_OMEGA, HARMONIC_KNOWN_SHARE = 1.95, 0.5
+
+
+def dilate(mask: np.ndarray, iterations: int) -> np.ndarray:
+    """cv::dilate with a 3x3 element `iterations` times; outside the image counts as
+    unset."""
+    for _ in range(iterations):
+        grown = mask.copy()
+        grown[1:] |= mask[:-1]
+        grown[:-1] |= mask[1:]
+        rows = grown.copy()
+        grown[:, 1:] |= rows[:, :-1]
+        grown[:, :-1] |= rows[:, 1:]
+        mask = grown
+    return mask
+
+
+def relax(f: np.ndarray, known: np.ndarray, sweeps: int, omega: float, band: int = 0):
+    """`sweeps` red-black over-relaxation sweeps of f [H, W, 3] in place, known [H, W]
+    kept (and, when band > 0, every pixel more than `band` 3x3 dilations from them): each
+    other pixel of one colour ((x + y) & 1) moves omega of the way to the mean of its
+    neighbours inside the image, then the other colour."""
+    if band > 0:
+        known = known | ~dilate(known, band)
+    h, w = known.shape
+    count = np.zeros((h, w, 1), np.float32)  # neighbours inside the image
+    count[:, 1:] += 1
+    count[:, :-1] += 1
+    count[1:] += 1
+    count[:-1] += 1
+    count = np.maximum(count, np.float32(1))  # a 1x1 image: no neighbour, no step
+    parity = np.add.outer(np.arange(h), np.arange(w)) & 1
+    # 1 on the unknown pixels of each colour: multiplying a step by it is exact
+    colours = [((parity == c) & ~known).astype(np.float32)[..., None] for c in (0, 1)]
+    omega = np.float32(omega)
+    for _ in range(sweeps):
+        for mask in colours:
+            total = np.zeros_like(f)  # left, right, up, down, as the C++ sums them
+            total[:, 1:] += f[:, :-1]
+            total[:, :-1] += f[:, 1:]
+            total[1:] += f[:-1]
+            total[:-1] += f[1:]
+            f += omega * (total / count - f) * mask
+
+
+def harmonic_float(rgb: np.ndarray, known: np.ndarray, coarsest_side: int = HARMONIC_COARSEST_SIDE,
+                   coarsest_sweeps: int = HARMONIC_COARSEST_SWEEPS, sweeps: int = HARMONIC_SWEEPS,
+                   band: int = HARMONIC_BAND, omega: float = HARMONIC_OMEGA) -> np.ndarray:
+    """As ampi::harmonic_estimate: push-pull's estimate relaxed towards Laplace's equation
+    on the unknown pixels, as a cascade above coarsest_side; None when nothing is known."""
+    start = push_pull_float(rgb, known)
+    if start is None:
+        return None
+    known = known > 0
+    levels = [(start, known)]
+    weight = known.astype(np.float32)[..., None]
+    weighted = (start * weight).astype(np.float32)
+    while max(levels[-1][1].shape) > coarsest_side:
+        h, w = levels[-1][1].shape
+        rows, cols = area_matrix(h, (h + 1) // 2), area_matrix(w, (w + 1) // 2)
+        colour = resample(levels[-1][0], rows, cols)
+        weight, weighted = resample(weight, rows, cols), resample(weighted, rows, cols)
+        coarse_known = weight[..., 0] >= np.float32(HARMONIC_KNOWN_SHARE)
+        known_mean = weighted / np.maximum(weight, np.float32(1e-12))
+        colour[coarse_known] = known_mean[coarse_known]
+        levels.append((colour, coarse_known))
+    estimate = levels[-1][0].copy()
+    relax(estimate, levels[-1][1], coarsest_sweeps, omega)
+    for colour, level_known in reversed(levels[:-1]):
+        (h, w), (eh, ew) = level_known.shape, estimate.shape[:2]
+        up = resample(estimate, linear_matrix(eh, h), linear_matrix(ew, w))
+        estimate = np.where(level_known[..., None], colour, up).astype(np.float32)
+        relax(estimate, level_known, sweeps, omega, band)
+    return estimate
+
+
+def harmonic_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray, **params) -> np.ndarray:
+    """As ampi::harmonic_fill: image uint8 [H, W, 3]; the pixels where fill is set take the
+    8-bit harmonic estimate from the known pixels (params: harmonic_float's), every other
+    pixel is unchanged."""
+    estimate = harmonic_float(image, known, **params)
+    if estimate is None:
+        return image.copy()
+    filled = np.clip(np.rint(estimate), 0, 255).astype(np.uint8)
+    out = image.copy()
+    out[fill > 0] = filled[fill > 0]
+    return out
+
+
+PREFILLS = {"push-pull": push_pull_fill, "harmonic": harmonic_fill}  # by inpaint.prefill name
+
+
+def write_fixture(path: str, seed: int, height: int, width: int, method: str = "push-pull", **params):
+    """A random image with a blob, a band and scattered known pixels, and its fill by
+    `method` (a PREFILLS name, with integer `params`, which go into the metadata), for
+    the C++ parity test (image, known, fill and expected as float tensors)."""
     import os
     import sys
     sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), ".."))
@@ -131,7 +226,7 @@ def write_fixture(path: str, seed: int, height: int, width: int):
     known &= ~((xx > width * 0.7) & (xx < width * 0.7 + 4))
     known &= rng.random((height, width)) > 0.1
     fill = ~known
-    expected = push_pull_fill(image, known, fill)
+    expected = PREFILLS[method](image, known, fill, **params)
     f32 = lambda a: np.ascontiguousarray(a, dtype=np.float32)  # noqa: E731
     write_ampw(path, {"image": f32(image), "known": f32(known), "fill": f32(fill),
-                      "expected": f32(expected)}, {"seed": seed})
+                      "expected": f32(expected)}, {"seed": seed, **params})

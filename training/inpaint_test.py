@@ -39,6 +39,28 @@ class PushPullTest(unittest.TestCase):
         self.assertTrue((pp.push_pull_fill(image, np.zeros((8, 8), bool), np.ones((8, 8), bool)) == 5).all())
 
 
+class HarmonicFillTest(unittest.TestCase):
+    def test_linear_ramp_is_continued_into_a_hole(self):
+        yy, xx = np.mgrid[0:40, 0:50]
+        image = np.stack([20 + 3 * xx, 200 - 2 * yy, 60 + xx + yy], -1).astype(np.uint8)
+        known = (yy - 20) ** 2 + (xx - 20) ** 2 > 100  # an interior disc is unknown
+        noisy = image.copy()
+        noisy[~known] = np.random.default_rng(0).integers(0, 256, (int((~known).sum()), 3))
+        out = pp.harmonic_fill(noisy, known, ~known)
+        err = np.abs(out.astype(int) - image.astype(int))
+        self.assertLessEqual(err.max(), 1)  # a linear ramp is harmonic: exact up to rounding
+        pushed = np.abs(pp.push_pull_fill(noisy, known, ~known).astype(int) - image.astype(int))
+        self.assertGreater(pushed.max(), 3)  # what the relaxation adds
+
+    def test_constant_and_nothing_known(self):
+        rng = np.random.default_rng(1)
+        image = np.full((9, 13, 3), 41, np.uint8)
+        known = rng.random((9, 13)) > 0.7
+        self.assertTrue((pp.harmonic_fill(image, known, ~known) == 41).all())
+        none = np.zeros((9, 13), bool)
+        self.assertTrue((pp.harmonic_fill(image, none, ~none) == image).all())
+
+
 class ResidualGeneratorTest(unittest.TestCase):
     def test_untrained_generator_returns_push_pull(self):
         torch.manual_seed(0)

@@ -42,7 +42,7 @@ import torch.nn.functional as F
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import depth_model  # noqa: E402
 import inpaint_data as data  # noqa: E402
-from inpaint_model import InpaintGenerator, PatchDiscriminator  # noqa: E402
+from inpaint_model import PREFILL, InpaintGenerator, PatchDiscriminator  # noqa: E402
 from losses import gradient_loss  # noqa: E402
 from export_inpaint import import_ampw as import_generator  # noqa: E402
 
@@ -159,7 +159,7 @@ def save_atomic(obj, path):
 
 def validation_key(args):
     """What the fixed validation samples depend on besides the photos."""
-    return {"crop": args.crop, "batch": args.batch, "seed": VALIDATION_SEED,
+    return {"crop": args.crop, "batch": args.batch, "seed": VALIDATION_SEED, "prefill": PREFILL,
             "standin_too": args.standin_too}
 
 
@@ -187,7 +187,7 @@ def load_or_init(args, g, d, opt_g, opt_d, log):
 
 
 def checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi):
-    save_atomic({"step": step, "best_psnr": best, "generator": g.state_dict(), "residual": g.residual,
+    save_atomic({"step": step, "best_psnr": best, "generator": g.state_dict(), "residual": g.residual, "prefill": PREFILL,
                  "discriminator": d.state_dict(), "opt_g": opt_g.state_dict(),
                  "opt_d": opt_d.state_dict(), "torch_rng": torch.get_rng_state(),
                  "numpy_rng": rng.bit_generator.state, "perceptual": phi.source,
@@ -250,9 +250,9 @@ def main(argv=None):
     opt_g = torch.optim.Adam(g.parameters(), lr=args.lr_g, betas=BETAS)
     opt_d = torch.optim.Adam(d.parameters(), lr=args.lr_d, betas=BETAS)
     step, best, rng = load_or_init(args, g, d, opt_g, opt_d, log)
-    if step == 0:  # what training starts from (push-pull itself for the residual net)
+    if step == 0:  # what training starts from (the prefill itself for an untrained residual net)
         best = validate(g, val_batches)[1]
-        save_atomic({"step": 0, "val_psnr": best, "generator": g.state_dict(), "residual": g.residual},
+        save_atomic({"step": 0, "val_psnr": best, "generator": g.state_dict(), "residual": g.residual, "prefill": PREFILL},
                     os.path.join(args.run_dir, "best.pt"))
         log(f"step 0: validation PSNR {best:.4f} (best.pt keeps it until a step beats it)")
 
@@ -281,7 +281,7 @@ def main(argv=None):
                 if row["val_psnr"] > best:
                     best = row["val_psnr"]
                     save_atomic({"step": step, "val_psnr": best, "generator": g.state_dict(),
-                                 "residual": g.residual},
+                                 "residual": g.residual, "prefill": PREFILL},
                                 os.path.join(args.run_dir, "best.pt"))
             if row is not None:
                 row.update(step=step, time=round(time.time() - started, 1))

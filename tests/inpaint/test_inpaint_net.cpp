@@ -6,10 +6,12 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <utility>
 
 #include <opencv2/imgproc.hpp>
 
 #include "inpaint/inpaint_net.h"
+#include "inpaint/harmonic_fill.h"
 #include "inpaint/push_pull.h"
 #include "support/random.h"
 
@@ -116,7 +118,7 @@ TEST_CASE("inpaint net: the graph is read from the file", "[inpaint]") {
   CHECK(net.layers().back().scale_log2 == 0);
   CHECK_FALSE(net.layers().back().gated);
   CHECK(net.macs_per_pixel() > 0);
-  CHECK(net.prefills_push_pull());  // version 2
+  CHECK(net.prefill() == Prefill::Harmonic);  // version 2, as training/inpaint_model.py PREFILL
 }
 
 TEST_CASE("inpaint net: version 2 changes only the hole of its input", "[inpaint]") {
@@ -165,7 +167,7 @@ TEST_CASE("inpaint net: bad inputs and bad files are one-line errors", "[inpaint
   CHECK(missing.find("enc1.weight") != std::string::npos);
   CHECK(missing.find('\n') == std::string::npos);
   const std::string prefill = expect_load_error("bad_prefill.ampw");
-  CHECK(prefill == kFixtures + "bad_prefill.ampw: inpaint.prefill 'telea' is not 'push-pull'");
+  CHECK(prefill == kFixtures + "bad_prefill.ampw: inpaint.prefill 'telea' is not 'push-pull' or 'harmonic'");
   const std::string depth = expect_load_error("tiny_case.ampw");
   CHECK(depth.find("not an inpainting network") != std::string::npos);
 }
@@ -184,34 +186,41 @@ TEST_CASE("inpaint filler: changes only the pixels to fill", "[inpaint]") {
 }
 
 TEST_CASE("inpaint filler: one window over the whole layer equals a direct run", "[inpaint]") {
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
-  const int h = 48, w = 64;  // multiples of 4: the window needs no padding
-  const Layer l = random_layer(h, w, 3);
-  const cv::Mat out = inpaint_layer(net, l.image, l.known, l.fill, {256, 256});
+  // the same tiny net, saved with each prefill: the filler must feed it the one named
+  for (const auto& [file, prefill] : {std::pair<const char*, Prefill>{"tiny.ampw", Prefill::Harmonic},
+                                      std::pair<const char*, Prefill>{"tiny_push_pull.ampw", Prefill::PushPull}}) {
+    INFO(file);
+    const InpaintNet net = InpaintNet::load(kFixtures + file);
+    REQUIRE(net.prefill() == prefill);
+    const int h = 48, w = 64;  // multiples of 4: the window needs no padding
+    const Layer l = random_layer(h, w, 3);
+    const cv::Mat out = inpaint_layer(net, l.image, l.known, l.fill, {256, 256});
 
-  // a version-2 network reads push-pull's fill in every unknown pixel
-  REQUIRE(net.prefills_push_pull());
-  const cv::Mat input = push_pull_fill(l.image, l.known, l.known == 0);
-  std::vector<float> rgb(size_t(h) * w * 3), hole(size_t(h) * w), pred(size_t(h) * w * 3);
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      const size_t p = size_t(y) * w + x;
-      const cv::Vec4b px = input.at<cv::Vec4b>(y, x);
-      for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = px[2 - c] / 127.5f - 1.0f;
-      hole[p] = l.known.at<uint8_t>(y, x) ? 0.0f : 1.0f;
-    }
-  net.run(rgb.data(), hole.data(), h, w, pred.data());
-  int mismatches = 0;
-  for (int y = 0; y < h; ++y)
-    for (int x = 0; x < w; ++x) {
-      if (!l.fill.at<uint8_t>(y, x)) continue;
-      const cv::Vec4b px = out.at<cv::Vec4b>(y, x);
-      for (int c = 0; c < 3; ++c) {
-        const long want = std::lround((pred[(size_t(y) * w + x) * 3 + c] + 1.0f) * 127.5f);
-        mismatches += std::abs(long(px[2 - c]) - std::clamp(want, 0L, 255L)) > 0;
+    // a version-2 network reads its prefill in every unknown pixel
+    const cv::Mat unknown = l.known == 0;
+    const cv::Mat input = prefill == Prefill::Harmonic ? harmonic_fill(l.image, l.known, unknown)
+                                                       : push_pull_fill(l.image, l.known, unknown);
+    std::vector<float> rgb(size_t(h) * w * 3), hole(size_t(h) * w), pred(size_t(h) * w * 3);
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        const size_t p = size_t(y) * w + x;
+        const cv::Vec4b px = input.at<cv::Vec4b>(y, x);
+        for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = px[2 - c] / 127.5f - 1.0f;
+        hole[p] = l.known.at<uint8_t>(y, x) ? 0.0f : 1.0f;
       }
-    }
-  CHECK(mismatches == 0);
+    net.run(rgb.data(), hole.data(), h, w, pred.data());
+    int mismatches = 0;
+    for (int y = 0; y < h; ++y)
+      for (int x = 0; x < w; ++x) {
+        if (!l.fill.at<uint8_t>(y, x)) continue;
+        const cv::Vec4b px = out.at<cv::Vec4b>(y, x);
+        for (int c = 0; c < 3; ++c) {
+          const long want = std::lround((pred[(size_t(y) * w + x) * 3 + c] + 1.0f) * 127.5f);
+          mismatches += std::abs(long(px[2 - c]) - std::clamp(want, 0L, 255L)) > 0;
+        }
+      }
+    CHECK(mismatches == 0);
+  }
 }
 
 TEST_CASE("inpaint filler: tiles cover a fill region larger than one core", "[inpaint]") {

@@ -1,11 +1,15 @@
-// The C++ push-pull (inpaint/push_pull.cpp) against training/inpaint_push_pull.py, the
-// numpy port the inpainting network trains with: the network's input at inference must be
-// the input it learned from. Fixtures written by training/export_inpaint.py.
+// The C++ prefills (inpaint/push_pull.cpp, inpaint/harmonic_fill.cpp) against
+// training/inpaint_push_pull.py, the numpy ports the inpainting network trains with: the
+// network's input at inference must be the input it learned from. Fixtures written by
+// training/export_inpaint.py.
 #include <catch2/catch.hpp>
 
 #include <cstdlib>
+#include <functional>
 #include <string>
+#include <vector>
 
+#include "inpaint/harmonic_fill.h"
 #include "inpaint/push_pull.h"
 #include "weights_format/weight_file.h"
 
@@ -23,12 +27,14 @@ cv::Mat as_bytes(const Tensor& t, int h, int w, int channels) {
   return m;
 }
 
-}  // namespace
+// The fill of image where fill != 0 from the known pixels; the fixture's metadata holds
+// the fill's parameters, if any.
+using Filler = std::function<cv::Mat(const cv::Mat&, const cv::Mat&, const cv::Mat&, const WeightFile&)>;
 
-TEST_CASE("push-pull: C++ and the training's numpy port give the same fill", "[inpaint][push-pull]") {
-  for (const char* name : {"push_pull_odd", "push_pull_even", "push_pull_thin"}) {
+void check_against_numpy(const std::vector<std::string>& names, const Filler& fill_with) {
+  for (const std::string& name : names) {
     INFO("fixture " << name);
-    const WeightFile f = WeightFile::open(kFixtures + name + ".ampw");
+    const WeightFile f = WeightFile::open(kFixtures + name);
     const TensorInfo* info = f.find("image");
     REQUIRE(info != nullptr);
     const int h = int(info->shape.at(0)), w = int(info->shape.at(1));
@@ -38,12 +44,13 @@ TEST_CASE("push-pull: C++ and the training's numpy port give the same fill", "[i
     const cv::Mat expected = as_bytes(f.tensor("expected", {h, w, 3}), h, w, 3);
     REQUIRE(cv::countNonZero(fill) > 0);
 
-    const cv::Mat filled = push_pull_fill(image, known, fill);
+    const cv::Mat filled = fill_with(image, known, fill, f);
     cv::Mat diff;
     cv::absdiff(filled, expected, diff);
     double worst = 0;
     cv::minMaxLoc(diff.reshape(1), nullptr, &worst);
-    // float sums in another order may round a .5 the other way: one level, rarely
+    // float sums in another order (or a fused multiply-add) may round a .5 the other
+    // way: one level, rarely
     const int off = cv::countNonZero(diff.reshape(1));
     INFO("max |diff| " << worst << ", " << off << " of " << diff.total() * 3 << " values differ");
     CHECK(worst <= 1);
@@ -52,5 +59,29 @@ TEST_CASE("push-pull: C++ and the training's numpy port give the same fill", "[i
     cv::Mat changed;
     cv::absdiff(expected, image, changed);
     CHECK(cv::countNonZero(changed.reshape(1)) > 0);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("push-pull: C++ and the training's numpy port give the same fill", "[inpaint][push-pull]") {
+  check_against_numpy({"push_pull_odd.ampw", "push_pull_even.ampw", "push_pull_thin.ampw"},
+                      [](const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill, const WeightFile&) {
+                        return push_pull_fill(image, known, fill);
+                      });
+}
+
+TEST_CASE("harmonic fill: C++ and the training's numpy port give the same fill", "[inpaint][harmonic]") {
+  for (int threads : {1, 2}) {
+    INFO(threads << " threads");
+    ThreadPool pool(threads);
+    check_against_numpy({"harmonic_odd.ampw", "harmonic_even.ampw", "harmonic_thin.ampw",
+                         "harmonic_cascade_odd.ampw", "harmonic_cascade_even.ampw"},
+                        [&](const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill, const WeightFile& f) {
+                          HarmonicFill params;
+                          if (f.has("coarsest_side")) params.coarsest_side = int(f.get_int("coarsest_side"));
+                          if (f.has("band")) params.band = int(f.get_int("band"));
+                          return harmonic_fill(image, known, fill, params, pool);
+                        });
   }
 }

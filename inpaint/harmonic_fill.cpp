@@ -1,0 +1,192 @@
+#include "inpaint/harmonic_fill.h"
+
+#include <algorithm>
+
+#include <opencv2/imgproc.hpp>
+#include <stdexcept>
+#include <vector>
+
+#include "inpaint/push_pull.h"
+
+namespace ampi {
+namespace {
+
+// Iterations run together in one pass over the rows (see relax_plane): 8 keep a window of
+// 32 rows in cache, where one pass per half-sweep streams the whole image from memory.
+constexpr int kFusedIterations = 8;
+// A coarse cell at least this much known is kept as known. Half keeps the boundary where
+// it is at every level; counting only wholly known cells moved it into the known side by
+// up to a coarse cell and cost 0.09 dB in `ampi eval inpaint` (10 photos, coarsest 128).
+constexpr float kKnownShare = 0.5f;
+
+// Which pixels each half-sweep updates: the unknown ones of one colour ((x + y) & 1),
+// as 0/1 per pixel, and per row the span [lo, hi] holding them (lo > hi: none).
+struct Unknowns {
+  cv::Mat selected[2];  // CV_32FC1: a step times 0 or 1 is exactly nothing or the step
+  std::vector<int> lo[2], hi[2];
+};
+
+Unknowns unknown_pixels(const cv::Mat& known) {
+  Unknowns u;
+  for (int c = 0; c < 2; ++c) {
+    u.selected[c] = cv::Mat::zeros(known.size(), CV_32FC1);
+    u.lo[c].assign(known.rows, known.cols);
+    u.hi[c].assign(known.rows, -1);
+  }
+  for (int y = 0; y < known.rows; ++y) {
+    const uint8_t* k = known.ptr<uint8_t>(y);
+    for (int x = 0; x < known.cols; ++x) {
+      if (k[x]) continue;
+      const int c = (x + y) & 1;
+      u.selected[c].ptr<float>(y)[x] = 1.0f;
+      u.lo[c][y] = std::min(u.lo[c][y], x);
+      u.hi[c][y] = std::max(u.hi[c][y], x);
+    }
+  }
+  return u;
+}
+
+// One pixel anywhere: v += omega (mean of the neighbours inside the image - v). The
+// neighbours are summed left, right, up, down, as the numpy version does, so both round
+// alike.
+void relax_pixel(cv::Mat& f, int y, int x, float omega) {
+  float* row = f.ptr<float>(y);
+  float sum = 0.0f, n = 0.0f;
+  if (x > 0) sum += row[x - 1], n += 1;
+  if (x + 1 < f.cols) sum += row[x + 1], n += 1;
+  if (y > 0) sum += f.ptr<float>(y - 1)[x], n += 1;
+  if (y + 1 < f.rows) sum += f.ptr<float>(y + 1)[x], n += 1;
+  if (n > 0) row[x] += omega * (sum / n - row[x]);  // n is 0 only in a 1x1 image
+}
+
+// One colour's half-sweep of row y. Inside the image's border every pixel has four
+// neighbours: the step is computed for the whole span into `step` and added times the
+// 0/1 selection, so both loops vectorise (the other colour's pixels are only read, so
+// computing their steps too changes nothing).
+void relax_row(cv::Mat& f, const Unknowns& u, int colour, int y, float omega, std::vector<float>& step) {
+  int lo = u.lo[colour][y], hi = u.hi[colour][y];
+  if (lo > hi) return;
+  const float* selected = u.selected[colour].ptr<float>(y);
+  if (y == 0 || y + 1 == f.rows) {
+    for (int x = lo; x <= hi; ++x)
+      if (selected[x]) relax_pixel(f, y, x, omega);
+    return;
+  }
+  if (lo == 0) relax_pixel(f, y, lo++, omega);
+  if (hi == f.cols - 1) relax_pixel(f, y, hi--, omega);
+  float* __restrict row = f.ptr<float>(y);
+  const float* __restrict up = f.ptr<float>(y - 1);
+  const float* __restrict down = f.ptr<float>(y + 1);
+  float* __restrict out = step.data();
+  for (int x = lo; x <= hi; ++x)  // * 0.25 is exactly / 4
+    out[x] = omega * ((row[x - 1] + row[x + 1] + up[x] + down[x]) * 0.25f - row[x]);
+  for (int x = lo; x <= hi; ++x) row[x] += out[x] * selected[x];
+}
+
+// `iterations` red-black sweeps of one colour channel. A half-sweep (stage) of row y only
+// reads rows y - 1..y + 1 as the previous stage left them, so stage s can run on row
+// t - 2 s at step t: a wavefront of 2 kFusedIterations stages, 2 rows apart, gives the
+// very values of sweeping the whole image stage after stage, from a window that fits in
+// cache.
+void relax_plane(cv::Mat& f, const Unknowns& u, int iterations, float omega) {
+  std::vector<float> step(f.cols);
+  for (int done = 0; done < iterations; done += kFusedIterations) {
+    const int stages = 2 * std::min(kFusedIterations, iterations - done);  // stage s: colour s & 1
+    for (int t = 0; t < f.rows + 2 * (stages - 1); ++t)
+      for (int s = 0; s < stages; ++s) {
+        const int y = t - 2 * s;
+        if (y >= 0 && y < f.rows) relax_row(f, u, s & 1, y, omega, step);
+      }
+  }
+}
+
+void check_params(const HarmonicFill& p) {
+  if (p.coarsest_side < 1 || p.coarsest_sweeps < 0 || p.sweeps < 0 || p.band < 0 ||
+      !(p.omega > 0 && p.omega < 2))
+    throw std::invalid_argument(
+        "harmonic_fill: needs coarsest_side >= 1, sweeps and band >= 0, omega in (0, 2)");
+}
+
+// One level of the cascade: start values everywhere (the known colour where known) and
+// the known pixels, which the sweeps keep.
+struct Level {
+  cv::Mat colour;  // CV_32FC3
+  cv::Mat known;   // CV_8UC1
+};
+
+// Halves each side ((n + 1) / 2, as push-pull's pyramid) until the long side is at most
+// coarsest_side. A coarse cell is known when at least kKnownShare of its area is, and
+// then holds the mean of its known pixels' colours; the others start from the mean of
+// push-pull's estimate and are solved.
+std::vector<Level> cascade_levels(const cv::Mat& start, const cv::Mat& known, int coarsest_side) {
+  std::vector<Level> levels{{start, known}};
+  cv::Mat weight, weight3, weighted;  // known share of each cell; colour x that share
+  known.convertTo(weight, CV_32F, 1.0 / 255.0);
+  cv::threshold(weight, weight, 0.0, 1.0, cv::THRESH_BINARY);
+  cv::merge(std::vector<cv::Mat>(3, weight), weight3);
+  weighted = start.mul(weight3);
+  while (std::max(levels.back().colour.cols, levels.back().colour.rows) > coarsest_side) {
+    const cv::Size half((levels.back().colour.cols + 1) / 2, (levels.back().colour.rows + 1) / 2);
+    Level coarse;
+    cv::resize(levels.back().colour, coarse.colour, half, 0, 0, cv::INTER_AREA);
+    cv::resize(weight, weight, half, 0, 0, cv::INTER_AREA);
+    cv::resize(weighted, weighted, half, 0, 0, cv::INTER_AREA);
+    coarse.known = weight >= kKnownShare;
+    cv::merge(std::vector<cv::Mat>(3, weight), weight3);
+    const cv::Mat known_mean = weighted / cv::max(weight3, 1e-12);  // read where known
+    known_mean.copyTo(coarse.colour, coarse.known);
+    levels.push_back(coarse);
+  }
+  return levels;
+}
+
+// `sweeps` red-black sweeps of `f` (CV_32FC3) keeping the known pixels and, when band > 0,
+// every pixel more than `band` 3x3 dilations away from them; the channels are
+// independent, one task each.
+void relax(cv::Mat& f, const cv::Mat& known, int sweeps, float omega, int band, ThreadPool& pool) {
+  if (sweeps == 0) return;
+  cv::Mat fixed = known;
+  if (band > 0) {
+    cv::Mat near;
+    cv::dilate(known, near, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}), {-1, -1}, band);
+    fixed = known | (near == 0);
+  }
+  const Unknowns u = unknown_pixels(fixed);
+  std::vector<cv::Mat> planes;
+  cv::split(f, planes);
+  pool.parallel_for(3, 1, [&](int64_t c0, int64_t c1) {
+    for (int64_t c = c0; c < c1; ++c) relax_plane(planes[c], u, sweeps, omega);
+  });
+  cv::merge(planes, f);
+}
+
+}  // namespace
+
+cv::Mat harmonic_estimate(const cv::Mat& image, const cv::Mat& known, const HarmonicFill& params,
+                          ThreadPool& pool) {
+  check_params(params);
+  const cv::Mat start = push_pull_estimate(image, known);
+  if (start.empty()) return start;
+  const std::vector<Level> levels = cascade_levels(start, known, params.coarsest_side);
+  cv::Mat estimate = levels.back().colour.clone();
+  relax(estimate, levels.back().known, params.coarsest_sweeps, params.omega, 0, pool);
+  for (size_t l = levels.size() - 1; l-- > 0;) {
+    // the coarser solution, brought up, starts the unknown pixels of this level
+    cv::Mat up;
+    cv::resize(estimate, up, levels[l].colour.size(), 0, 0, cv::INTER_LINEAR);
+    estimate = levels[l].colour.clone();
+    up.copyTo(estimate, levels[l].known == 0);
+    relax(estimate, levels[l].known, params.sweeps, params.omega, params.band, pool);
+  }
+  return estimate;
+}
+
+cv::Mat harmonic_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill,
+                      const HarmonicFill& params, ThreadPool& pool) {
+  if (fill.type() != CV_8UC1 || fill.size() != image.size())
+    throw std::invalid_argument("harmonic_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+  const cv::Mat estimate = harmonic_estimate(image, known, params, pool);
+  return estimate.empty() ? image.clone() : paste_estimate(image, estimate, fill);
+}
+
+}  // namespace ampi
