@@ -35,7 +35,7 @@ namespace {
 
 const char kUsage[] =
     "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
-    "                           [--inpainter network|push-pull] [--working-size N] [--out FILE]\n"
+    "                           [--inpainter network|harmonic|push-pull] [--working-size N] [--out FILE]\n"
     "\n"
     "Times every stage of `ampi run` (decode, depth, slicing, assembly, inpainting, MPI\n"
     "write, render + encode of the video) on PHOTO resized to 1024x768 and to 3840x2160,\n"
@@ -47,7 +47,7 @@ const char kUsage[] =
     "  --runs N       runs per size (default 3)\n"
     "  --threads N    worker threads (default 2)\n"
     "  --frames N     video frames rendered and encoded per run (default 30)\n"
-    "  --inpainter NAME      network (default, as ampi run) or push-pull\n"
+    "  --inpainter NAME      network (default, as ampi run), harmonic or push-pull\n"
     "  --working-size N      the depth network's long side (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
@@ -171,7 +171,7 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
      << "the warm-up that loads the networks included. As in `ampi run`, the heap's free\n"
      << "memory is handed back to the system after each photo and after any stage that leaves\n"
      << "64 MB or more free (pipeline/progress.h), outside the stage times. Inpainting: "
-     << (options.network_inpainting ? "the network" : "push-pull") << "; depth network's long side: "
+     << inpainter_name(options.inpainter) << "; depth network's long side: "
      << (options.working_size ? std::to_string(options.working_size) : std::string("the weight file's"))
      << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"
      << "| stage |";
@@ -241,11 +241,7 @@ int pipeline_benchmark(int argc, char** argv) {
   p.option("--threads", &threads, 1, 256);
   p.option("--frames", &frames, 1, 10000);
   p.option("--out", &out);
-  p.option("--inpainter", [&](const std::string& v) {
-    if (v != "push-pull" && v != "network")
-      throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
-    options.network_inpainting = v == "network";
-  });
+  p.option("--inpainter", [&](const std::string& v) { options.inpainter = parse_inpainter(v); });
   p.option("--working-size", &options.working_size, kMinPhotoSide, 16384);
   if (!p.parse(argc, argv)) return 0;
   set_default_threads(threads);

@@ -44,7 +44,8 @@ const char kInpaintUsage[] =
     "and every plane behind it are eroded with a 3x3 element N times, and each method fills\n"
     "the removed border from the eroded region alone. Prints PSNR (dB) and SSIM over the\n"
     "removed pixels, averaged over the (photo, plane) samples, one row per method: ampi\n"
-    "(the network), telea and ns (OpenCV cv::inpaint), push-pull.\n"
+    "(the network), telea and ns (OpenCV cv::inpaint), push-pull and harmonic (the two\n"
+    "classic fills a network may start from; the bundled one refines harmonic).\n"
     "\n"
     "  --images DIR          photos to evaluate on (use photos the network never trained on)\n"
     "  --weights FILE        inpainting weights (default: the bundled weights/inpaint.ampw)\n"
@@ -150,7 +151,8 @@ int eval_inpaint(int argc, char** argv) {
   InpaintEvaluator eval({{"ampi", network_filler(net)},
                          {"telea", telea_filler(a.radius)},
                          {"ns", navier_stokes_filler(a.radius)},
-                         {"push-pull", push_pull_margin_filler()}});
+                         {"push-pull", push_pull_margin_filler()},
+                         {"harmonic", harmonic_margin_filler()}});
   for (const std::string& path : photos) {
     const cv::Mat bgr = fit_long_side(read_photo(path), a.max_size);
     const cv::Mat raw = depth ? estimate_disparity(*depth, bgr, a.max_size)
@@ -430,7 +432,7 @@ struct Mode {
 const Mode kModes[] = {
     {"depth", eval_depth, "depth metrics (delta, RMSE, REL) against reference maps, vs. a vertical gradient"},
     {"slicing", eval_slicing, "the paper's Table 3: adaptive vs. uniform MPIs against a dense one (SSIM, PSNR)"},
-    {"inpaint", eval_inpaint, "margin filling: ampi vs. cv::inpaint Telea / Navier-Stokes, push-pull"},
+    {"inpaint", eval_inpaint, "margin filling: ampi vs. cv::inpaint Telea / Navier-Stokes, push-pull, harmonic"},
 };
 
 void usage(FILE* out) {

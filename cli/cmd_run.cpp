@@ -54,7 +54,8 @@ const char kUsage[] =
     "  --min-plane-share F     adaptive cuts leave each plane more than F/N of the depth\n"
     "                          histogram, N = --max-planes (default 0.5; 0: the paper's rule)\n"
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
-    "  --inpainter NAME        network (default) or push-pull (faster): what fills occluded margins\n"
+    "  --inpainter NAME        what fills occluded margins: network (default), harmonic (as close\n"
+    "                          to the truth, no texture, faster) or push-pull (fastest)\n"
     "  --inpaint-weights FILE  inpainting network weight file (implies --inpainter network)\n"
     "  --fov DEG               assumed horizontal field of view (default 60)\n"
     "  --trajectory NAME       circle, swing, zoom-in or dolly-zoom (default circle)\n"
@@ -104,11 +105,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--min-plane-share", &a.mpi.slicing.min_plane_share, 0.0, 1.0);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
-  p.option("--inpainter", [&](const std::string& v) {
-    if (v != "push-pull" && v != "network")
-      throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
-    a.mpi.network_inpainting = v == "network";
-  });
+  p.option("--inpainter", [&](const std::string& v) { a.mpi.inpainter = parse_inpainter(v); });
   p.option("--fov", &a.mpi.fov_degrees, 1, 179);
   PathOptions& path = a.video_options.path;
   p.option("--trajectory", [&](const std::string& v) { path.kind = parse_path_kind(v); });

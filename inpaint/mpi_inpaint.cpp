@@ -2,11 +2,35 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include <stdexcept>
+
+#include "inpaint/harmonic_fill.h"
 #include "inpaint/push_pull.h"
 
 namespace ampi {
 
 LayerFiller push_pull_filler() { return push_pull_fill; }
+
+LayerFiller harmonic_filler() {
+  return [](const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill) {
+    return harmonic_fill(image, known, fill);
+  };
+}
+
+Inpainter parse_inpainter(const std::string& name) {
+  for (Inpainter kind : {Inpainter::Network, Inpainter::Harmonic, Inpainter::PushPull})
+    if (name == inpainter_name(kind)) return kind;
+  throw std::runtime_error("--inpainter: '" + name + "' is not network, harmonic or push-pull");
+}
+
+const char* inpainter_name(Inpainter kind) {
+  switch (kind) {
+    case Inpainter::Network: return "network";
+    case Inpainter::Harmonic: return "harmonic";
+    case Inpainter::PushPull: break;
+  }
+  return "push-pull";
+}
 
 namespace {
 

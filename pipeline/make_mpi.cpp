@@ -14,6 +14,16 @@
 
 namespace ampi {
 
+LayerFiller make_layer_filler(Inpainter kind, const std::string& weights) {
+  switch (kind) {
+    case Inpainter::Harmonic: return harmonic_filler();
+    case Inpainter::PushPull: return push_pull_filler();
+    case Inpainter::Network: break;
+  }
+  const std::string path = weights.empty() ? find_weights("inpaint.ampw") : weights;
+  return inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(path)));
+}
+
 namespace {
 
 // The margin to fill scales with the photo: the paper's 40 px are at about 1024 px.
@@ -61,15 +71,9 @@ cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, cv::Size photo_size, con
 
 LayerFiller& MpiMaker::filler() {
   if (filler_) return *filler_;
-  if (!options_.network_inpainting && options_.inpaint_weights.empty()) {  // weights imply the network
-    filler_ = push_pull_filler();
-    inpainter_ = "push-pull";
-  } else {
-    const std::string path = options_.inpaint_weights.empty() ? find_weights("inpaint.ampw")
-                                                               : options_.inpaint_weights;
-    filler_ = inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(path)));
-    inpainter_ = "network";
-  }
+  const Inpainter kind = options_.inpaint_weights.empty() ? options_.inpainter : Inpainter::Network;
+  filler_ = make_layer_filler(kind, options_.inpaint_weights);
+  inpainter_ = inpainter_name(kind);
   return *filler_;
 }
 

@@ -26,10 +26,10 @@ struct MpiOptions {
   SlicingParams slicing;             // max_planes, the paper's constants, depth range
   double soft_alpha = 0;             // alpha ramp across plane cuts (0 = the paper)
   // Which filler invents the occluded margins. The network by default: on held-out photos
-  // it scores above push-pull, Telea and Navier-Stokes (training/INPAINT.md); push-pull
-  // (false) is about 4x faster.
-  bool network_inpainting = true;
-  std::string inpaint_weights;       // the network's weight file instead of the bundled one
+  // it scores above Telea and Navier-Stokes (training/INPAINT.md). The harmonic fill alone
+  // scores the same PSNR (the network adds texture); push-pull is the fastest.
+  Inpainter inpainter = Inpainter::Network;
+  std::string inpaint_weights;       // the network's weight file (implies the network)
   double fov_degrees = 60;           // assumed horizontal field of view of the photo
   // A photo whose long side is larger is made into an MPI at this size (depth,
   // slicing, layers, inpainting, and the video and viewer drawn from them), and only its
@@ -39,10 +39,14 @@ struct MpiOptions {
   int max_working_side = 3840;
 };
 
+// The filler `kind` names; the network from `weights`, or the bundled
+// weights/inpaint.ampw when empty.
+LayerFiller make_layer_filler(Inpainter kind, const std::string& weights = "");
+
 struct MpiResult {
   cv::Mat disparity;  // CV_32FC1 at the MPI's size, larger = nearer
   Mpi mpi;            // inpainted; at the photo's size unless the photo was reduced
-  std::string inpainter;  // which filler ran: "network" or "push-pull"
+  std::string inpainter;  // which filler ran: inpainter_name
   cv::Size slicing_size;  // the map the slicer ran on (the depth network's working size)
   // Set only when the photo was larger than max_working_side: the photo itself and its
   // camera, from which full_resolution.h makes the written layers.

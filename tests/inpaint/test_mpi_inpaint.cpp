@@ -1,6 +1,9 @@
 #include <catch2/catch.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <stdexcept>
+#include <string>
+
 #include "inpaint/mpi_inpaint.h"
 #include "inpaint/push_pull.h"
 
@@ -98,4 +101,27 @@ TEST_CASE("occlusion masks equal the paper's iterated 3x3 dilation on random lay
       nearer |= coverage;
     }
   }
+}
+
+TEST_CASE("inpainter names: parsed, named back, and a bad one refused with the choices") {
+  for (Inpainter kind : {Inpainter::Network, Inpainter::Harmonic, Inpainter::PushPull})
+    CHECK(parse_inpainter(inpainter_name(kind)) == kind);
+  CHECK(std::string(inpainter_name(Inpainter::Harmonic)) == "harmonic");
+  try {
+    parse_inpainter("telea");
+    FAIL("no error");
+  } catch (const std::runtime_error& e) {
+    CHECK(std::string(e.what()) == "--inpainter: 'telea' is not network, harmonic or push-pull");
+  }
+}
+
+TEST_CASE("inpaint_mpi with the harmonic filler continues the back layer's colour") {
+  Mpi mpi = two_layer_mpi();
+  const cv::Mat back = mpi.layers[0].clone();
+  CHECK(inpaint_mpi(mpi, harmonic_filler(), {5}) == 150);
+  const auto masks = occlusion_masks({back, mpi.layers[1]}, {5});
+  for (int y = 0; y < 60; ++y)
+    for (int x = 0; x < 80; ++x)
+      if (masks[0].at<uchar>(y, x))
+        REQUIRE(mpi.layers[0].at<cv::Vec4b>(y, x) == cv::Vec4b(10, 200, 30, 255));
 }

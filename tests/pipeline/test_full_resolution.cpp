@@ -74,7 +74,7 @@ TEST_CASE("a photo above max_working_side: MPI at the reduced size, written laye
   MpiOptions options;
   options.depth_file = depth_file;
   options.max_working_side = 32;
-  options.network_inpainting = false;  // what is tested is the sizes, not the fill: no weight file
+  options.inpainter = Inpainter::PushPull;  // what is tested is the sizes, not the fill: no weight file
   MpiMaker maker(options);
   Progress progress(true);
   const MpiResult result = maker.make(bgr, "photo", progress);
