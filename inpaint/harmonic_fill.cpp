@@ -145,12 +145,10 @@ std::vector<Level> cascade_levels(const cv::Mat& start, const cv::Mat& known, in
 // independent, one task each.
 void relax(cv::Mat& f, const cv::Mat& known, int sweeps, float omega, int band, ThreadPool& pool) {
   if (sweeps == 0) return;
-  cv::Mat fixed = known;
-  if (band > 0) {
-    cv::Mat near;
-    cv::dilate(known, near, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}), {-1, -1}, band);
-    fixed = known | (near == 0);
-  }
+  cv::Mat near;
+  if (band > 0) cv::dilate(known, near, cv::getStructuringElement(cv::MORPH_RECT, {3, 3}), {-1, -1}, band);
+  // a new matrix: assigning the expression to a header of `known` would write into it
+  const cv::Mat fixed = band > 0 ? cv::Mat(known | (near == 0)) : known;
   const Unknowns u = unknown_pixels(fixed);
   std::vector<cv::Mat> planes;
   cv::split(f, planes);

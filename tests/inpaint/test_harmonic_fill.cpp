@@ -71,12 +71,21 @@ TEST_CASE("harmonic fill changes only the pixels to fill, whatever the thread co
   std::mt19937 rng(5);
   for (int y = 0; y < 37; ++y)
     for (int x = 0; x < 53; ++x) known.at<uint8_t>(y, x) = (rng() % 3 == 0 || x < 10) ? 255 : 0;
+  known(cv::Rect(20, 8, 30, 22)).setTo(0);  // a hole wider than the band
   fill = (known == 0);
   fill(cv::Rect(0, 0, 53, 18)).setTo(0);  // fill only the lower half of the hole
+  const cv::Mat image_before = image.clone(), known_before = known.clone(), fill_before = fill.clone();
+  HarmonicFill cascade;  // three levels, the finer two within a band: every step runs
+  cascade.coarsest_side = 12;
+  cascade.band = 2;
   ThreadPool one(1), three(3);
-  const cv::Mat a = harmonic_fill(image, known, fill, {}, one);
-  const cv::Mat b = harmonic_fill(image, known, fill, {}, three);
+  const cv::Mat a = harmonic_fill(image, known, fill, cascade, one);
+  const cv::Mat b = harmonic_fill(image, known, fill, cascade, three);
   CHECK(cv::norm(a, b, cv::NORM_INF) == 0);  // red-black sweeps have no order to race on
+  // the inputs are the caller's: none is written
+  CHECK(cv::norm(image, image_before, cv::NORM_INF) == 0);
+  CHECK(cv::norm(known, known_before, cv::NORM_INF) == 0);
+  CHECK(cv::norm(fill, fill_before, cv::NORM_INF) == 0);
   const cv::Mat differs = a != image;  // per channel
   cv::Mat changed;
   cv::reduce(differs.reshape(1, 37 * 53), changed, 1, cv::REDUCE_MAX);
