@@ -19,28 +19,32 @@ constexpr int kFusedIterations = 8;
 // up to a coarse cell and cost 0.09 dB in `ampi eval inpaint` (10 photos, coarsest 128).
 constexpr float kKnownShare = 0.5f;
 
-// Which pixels each half-sweep updates: the unknown ones of one colour ((x + y) & 1),
-// as 0/1 per pixel, and per row the span [lo, hi] holding them (lo > hi: none).
+// Runs of moving pixels closer than this are swept as one: computing a few fixed
+// pixels' steps (then multiplied by 0) costs less than starting another vector loop.
+constexpr int kRunGap = 16;
+
+// Which pixels each half-sweep updates: the moving (unknown) ones of one colour
+// ((x + y) & 1) as 0/1 per pixel, and per row the runs [start, end) of moving pixels of
+// either colour, so rows crossing a hole's fixed interior skip it.
 struct Unknowns {
-  cv::Mat selected[2];  // CV_32FC1: a step times 0 or 1 is exactly nothing or the step
-  std::vector<int> lo[2], hi[2];
+  cv::Mat selected[2];  // CV_8UC1 0 or 1: a step times it is exactly nothing or the step
+  std::vector<std::vector<cv::Range>> runs;
 };
 
 Unknowns unknown_pixels(const cv::Mat& known) {
   Unknowns u;
-  for (int c = 0; c < 2; ++c) {
-    u.selected[c] = cv::Mat::zeros(known.size(), CV_32FC1);
-    u.lo[c].assign(known.rows, known.cols);
-    u.hi[c].assign(known.rows, -1);
-  }
+  for (cv::Mat& s : u.selected) s = cv::Mat::zeros(known.size(), CV_8UC1);
+  u.runs.resize(known.rows);
   for (int y = 0; y < known.rows; ++y) {
     const uint8_t* k = known.ptr<uint8_t>(y);
+    std::vector<cv::Range>& runs = u.runs[y];
     for (int x = 0; x < known.cols; ++x) {
       if (k[x]) continue;
-      const int c = (x + y) & 1;
-      u.selected[c].ptr<float>(y)[x] = 1.0f;
-      u.lo[c][y] = std::min(u.lo[c][y], x);
-      u.hi[c][y] = std::max(u.hi[c][y], x);
+      u.selected[(x + y) & 1].ptr<uint8_t>(y)[x] = 1;
+      if (!runs.empty() && x - runs.back().end < kRunGap)
+        runs.back().end = x + 1;
+      else
+        runs.emplace_back(x, x + 1);
     }
   }
   return u;
@@ -59,28 +63,30 @@ void relax_pixel(cv::Mat& f, int y, int x, float omega) {
   if (n > 0) row[x] += omega * (sum / n - row[x]);  // n is 0 only in a 1x1 image
 }
 
-// One colour's half-sweep of row y. Inside the image's border every pixel has four
-// neighbours: the step is computed for the whole span into `step` and added times the
-// 0/1 selection, so both loops vectorise (the other colour's pixels are only read, so
-// computing their steps too changes nothing).
-void relax_row(cv::Mat& f, const Unknowns& u, int colour, int y, float omega, std::vector<float>& step) {
-  int lo = u.lo[colour][y], hi = u.hi[colour][y];
-  if (lo > hi) return;
-  const float* selected = u.selected[colour].ptr<float>(y);
+// One colour's half-sweep of the pixels [lo, hi] of row y. Inside the image's border
+// every pixel has four neighbours: the step is computed for the whole run into `step`
+// and added times the 0/1 selection, so both loops vectorise (the other colour's pixels
+// are only read, so computing their steps too changes nothing).
+void relax_run(cv::Mat& f, const uint8_t* selected, int y, int lo, int hi, float omega, std::vector<float>& step) {
   if (y == 0 || y + 1 == f.rows) {
     for (int x = lo; x <= hi; ++x)
       if (selected[x]) relax_pixel(f, y, x, omega);
     return;
   }
-  if (lo == 0) relax_pixel(f, y, lo++, omega);
-  if (hi == f.cols - 1) relax_pixel(f, y, hi--, omega);
+  if (lo == 0 && selected[lo++]) relax_pixel(f, y, 0, omega);
+  if (hi == f.cols - 1 && selected[hi--]) relax_pixel(f, y, f.cols - 1, omega);
   float* __restrict row = f.ptr<float>(y);
   const float* __restrict up = f.ptr<float>(y - 1);
   const float* __restrict down = f.ptr<float>(y + 1);
   float* __restrict out = step.data();
   for (int x = lo; x <= hi; ++x)  // * 0.25 is exactly / 4
     out[x] = omega * ((row[x - 1] + row[x + 1] + up[x] + down[x]) * 0.25f - row[x]);
-  for (int x = lo; x <= hi; ++x) row[x] += out[x] * selected[x];
+  for (int x = lo; x <= hi; ++x) row[x] += out[x] * float(selected[x]);
+}
+
+void relax_row(cv::Mat& f, const Unknowns& u, int colour, int y, float omega, std::vector<float>& step) {
+  const uint8_t* selected = u.selected[colour].ptr<uint8_t>(y);
+  for (const cv::Range& r : u.runs[y]) relax_run(f, selected, y, r.start, r.end - 1, omega, step);
 }
 
 // `iterations` red-black sweeps of one colour channel. A half-sweep (stage) of row y only
@@ -101,10 +107,10 @@ void relax_plane(cv::Mat& f, const Unknowns& u, int iterations, float omega) {
 }
 
 void check_params(const HarmonicFill& p) {
-  if (p.coarsest_side < 1 || p.coarsest_sweeps < 0 || p.sweeps < 0 || p.band < 0 ||
-      !(p.omega > 0 && p.omega < 2))
+  if (p.coarsest_side < 1 || p.start_side < p.coarsest_side || p.coarsest_sweeps < 0 || p.sweeps < 0 ||
+      p.band < 0 || !(p.omega > 0 && p.omega < 2))
     throw std::invalid_argument(
-        "harmonic_fill: needs coarsest_side >= 1, sweeps and band >= 0, omega in (0, 2)");
+        "harmonic_fill: needs 1 <= coarsest_side <= start_side, sweeps and band >= 0, omega in (0, 2)");
 }
 
 // One level of the cascade: start values everywhere (the known colour where known) and
@@ -115,24 +121,25 @@ struct Level {
 };
 
 // Halves each side ((n + 1) / 2, as push-pull's pyramid) until the long side is at most
-// coarsest_side. A coarse cell is known when at least kKnownShare of its area is, and
-// then holds the mean of its known pixels' colours; the others start from the mean of
-// push-pull's estimate and are solved.
-std::vector<Level> cascade_levels(const cv::Mat& start, const cv::Mat& known, int coarsest_side) {
-  std::vector<Level> levels{{start, known}};
+// coarsest_side, or a level would have no known cell. A coarse cell is known when at
+// least kKnownShare of its area is, and then holds the mean of its known pixels'
+// colours (the others hold 0 until solved).
+std::vector<Level> cascade_levels(const cv::Mat& colour, const cv::Mat& known, int coarsest_side) {
+  std::vector<Level> levels{{colour, known}};
   cv::Mat weight, weight3, weighted;  // known share of each cell; colour x that share
   known.convertTo(weight, CV_32F, 1.0 / 255.0);
   cv::threshold(weight, weight, 0.0, 1.0, cv::THRESH_BINARY);
   cv::merge(std::vector<cv::Mat>(3, weight), weight3);
-  weighted = start.mul(weight3);
+  weighted = colour.mul(weight3);
   while (std::max(levels.back().colour.cols, levels.back().colour.rows) > coarsest_side) {
     const cv::Size half((levels.back().colour.cols + 1) / 2, (levels.back().colour.rows + 1) / 2);
-    Level coarse;
-    cv::resize(levels.back().colour, coarse.colour, half, 0, 0, cv::INTER_AREA);
     cv::resize(weight, weight, half, 0, 0, cv::INTER_AREA);
     cv::resize(weighted, weighted, half, 0, 0, cv::INTER_AREA);
+    Level coarse;
     coarse.known = weight >= kKnownShare;
+    if (cv::countNonZero(coarse.known) == 0) break;  // scattered known pixels: stay finer
     cv::merge(std::vector<cv::Mat>(3, weight), weight3);
+    coarse.colour = cv::Mat::zeros(half, CV_32FC3);
     const cv::Mat known_mean = weighted / cv::max(weight3, 1e-12);  // read where known
     known_mean.copyTo(coarse.colour, coarse.known);
     levels.push_back(coarse);
@@ -158,15 +165,36 @@ void relax(cv::Mat& f, const cv::Mat& known, int sweeps, float omega, int band, 
   cv::merge(planes, f);
 }
 
+// The coarsest level's start: push-pull's estimate on the first level at most start_side
+// pixels, averaged down level by level with the known cells set to their colour.
+cv::Mat coarsest_start(const std::vector<Level>& levels, int start_side) {
+  size_t l = 0;
+  while (l + 1 < levels.size() && std::max(levels[l].colour.cols, levels[l].colour.rows) > start_side) ++l;
+  cv::Mat start = push_pull_estimate(levels[l].colour, levels[l].known);
+  for (++l; l < levels.size(); ++l) {
+    cv::resize(start, start, levels[l].colour.size(), 0, 0, cv::INTER_AREA);
+    levels[l].colour.copyTo(start, levels[l].known);
+  }
+  return start;
+}
+
 }  // namespace
 
 cv::Mat harmonic_estimate(const cv::Mat& image, const cv::Mat& known, const HarmonicFill& params,
                           ThreadPool& pool) {
   check_params(params);
-  const cv::Mat start = push_pull_estimate(image, known);
-  if (start.empty()) return start;
-  const std::vector<Level> levels = cascade_levels(start, known, params.coarsest_side);
-  cv::Mat estimate = levels.back().colour.clone();
+  if ((image.type() != CV_8UC3 && image.type() != CV_8UC4) || known.type() != CV_8UC1 ||
+      known.size() != image.size())
+    throw std::invalid_argument("harmonic_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+  if (cv::countNonZero(known) == 0) return cv::Mat();  // nothing to spread
+  cv::Mat bgr, colour;
+  if (image.channels() == 4)
+    cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+  else
+    bgr = image;
+  bgr.convertTo(colour, CV_32F);
+  const std::vector<Level> levels = cascade_levels(colour, known, params.coarsest_side);
+  cv::Mat estimate = coarsest_start(levels, params.start_side);
   relax(estimate, levels.back().known, params.coarsest_sweeps, params.omega, 0, pool);
   for (size_t l = levels.size() - 1; l-- > 0;) {
     // the coarser solution, brought up, starts the unknown pixels of this level

@@ -50,7 +50,8 @@ void check_fill_inputs(const char* who, const cv::Mat& image, const cv::Mat& kno
 }  // namespace
 
 cv::Mat push_pull_estimate(const cv::Mat& image, const cv::Mat& known) {
-  check_fill_inputs("push_pull_estimate", image, known);
+  if (image.type() != CV_32FC3) check_fill_inputs("push_pull_estimate", image, known);
+  CV_Assert(known.type() == CV_8UC1 && known.size() == image.size());
   cv::Mat bgr;
   if (image.channels() == 4)
     cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);

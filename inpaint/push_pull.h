@@ -14,7 +14,7 @@ namespace ampi {
 cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill);
 
 // The float estimate behind push_pull_fill: CV_32FC3 at every pixel (the known colour
-// where known), from an 8-bit BGR(A) image. Empty when no pixel is known.
+// where known), from an 8-bit BGR(A) or a CV_32FC3 image. Empty when no pixel is known.
 cv::Mat push_pull_estimate(const cv::Mat& image, const cv::Mat& known);
 
 // A copy of image (CV_8UC3 or CV_8UC4) whose colour channels take the 8-bit rounding of

@@ -162,7 +162,8 @@ def write_prefill_fixtures():
             inpaint_push_pull.write_fixture(os.path.join(FIXTURES, name), seed, h, w, method)
     for size, seed, h, w in (("odd", 24, 37, 53), ("even", 25, 64, 48)):
         inpaint_push_pull.write_fixture(os.path.join(FIXTURES, f"harmonic_cascade_{size}.ampw"), seed, h, w,
-                                        "harmonic", coarsest_side=12, band=3)
+                                        "harmonic", coarsest_side=12, start_side=30, band=3,
+                                        coarsest_sweeps=3, sweeps=2)  # few: the start shows
 
 
 def write_bad_fixtures():

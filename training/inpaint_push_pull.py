@@ -114,7 +114,8 @@ def push_pull_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray, **_pa
 
 
 # inpaint/harmonic_fill.h HarmonicFill and kKnownShare
-HARMONIC_COARSEST_SIDE, HARMONIC_COARSEST_SWEEPS, HARMONIC_SWEEPS, HARMONIC_BAND = 256, 100, 25, 48
+HARMONIC_COARSEST_SIDE, HARMONIC_START_SIDE = 256, 1024
+HARMONIC_COARSEST_SWEEPS, HARMONIC_SWEEPS, HARMONIC_BAND = 100, 25, 48
 HARMONIC_OMEGA, HARMONIC_KNOWN_SHARE = 1.95, 0.5
 
 
@@ -162,26 +163,33 @@ def relax(f: np.ndarray, known: np.ndarray, sweeps: int, omega: float, band: int
 
 def harmonic_float(rgb: np.ndarray, known: np.ndarray, coarsest_side: int = HARMONIC_COARSEST_SIDE,
                    coarsest_sweeps: int = HARMONIC_COARSEST_SWEEPS, sweeps: int = HARMONIC_SWEEPS,
-                   band: int = HARMONIC_BAND, omega: float = HARMONIC_OMEGA) -> np.ndarray:
-    """As ampi::harmonic_estimate: push-pull's estimate relaxed towards Laplace's equation
-    on the unknown pixels, as a cascade above coarsest_side; None when nothing is known."""
-    start = push_pull_float(rgb, known)
-    if start is None:
-        return None
+                   band: int = HARMONIC_BAND, omega: float = HARMONIC_OMEGA,
+                   start_side: int = HARMONIC_START_SIDE) -> np.ndarray:
+    """As ampi::harmonic_estimate: Laplace's equation on the unknown pixels, solved by
+    over-relaxation as a cascade above coarsest_side, push-pull (made at most start_side
+    large) starting the coarsest level; None when nothing is known."""
     known = known > 0
-    levels = [(start, known)]
-    weight = known.astype(np.float32)[..., None]
-    weighted = (start * weight).astype(np.float32)
+    if not known.any():
+        return None
+    levels = [(rgb.astype(np.float32), known)]
+    weight = known.astype(np.float32)[..., None]  # known share of each cell
+    weighted = levels[0][0] * weight  # colour x that share
     while max(levels[-1][1].shape) > coarsest_side:
         h, w = levels[-1][1].shape
         rows, cols = area_matrix(h, (h + 1) // 2), area_matrix(w, (w + 1) // 2)
-        colour = resample(levels[-1][0], rows, cols)
         weight, weighted = resample(weight, rows, cols), resample(weighted, rows, cols)
         coarse_known = weight[..., 0] >= np.float32(HARMONIC_KNOWN_SHARE)
-        known_mean = weighted / np.maximum(weight, np.float32(1e-12))
-        colour[coarse_known] = known_mean[coarse_known]
+        if not coarse_known.any():
+            break  # scattered known pixels: stay finer
+        colour = np.zeros(weighted.shape, np.float32)
+        colour[coarse_known] = (weighted / np.maximum(weight, np.float32(1e-12)))[coarse_known]
         levels.append((colour, coarse_known))
-    estimate = levels[-1][0].copy()
+    first = next(i for i, (_, k) in enumerate(levels) if max(k.shape) <= start_side or i + 1 == len(levels))
+    estimate = push_pull_float(*levels[first])
+    for colour, level_known in levels[first + 1:]:  # averaged down, known cells set
+        h, w = level_known.shape
+        estimate = resample(estimate, area_matrix(estimate.shape[0], h), area_matrix(estimate.shape[1], w))
+        estimate[level_known] = colour[level_known]
     relax(estimate, levels[-1][1], coarsest_sweeps, omega)
     for colour, level_known in reversed(levels[:-1]):
         (h, w), (eh, ew) = level_known.shape, estimate.shape[:2]

@@ -112,6 +112,20 @@ TEST_CASE("harmonic fill: no sweeps is push-pull; edge cases; bad input", "[inpa
   cv::Mat pixel(1, 1, CV_8UC3, cv::Scalar(1, 2, 3)), pixel_known(1, 1, CV_8UC1, cv::Scalar(255));
   CHECK(cv::norm(harmonic_fill(pixel, pixel_known, pixel_known == 0), pixel, cv::NORM_INF) == 0);
 
+  // known pixels too scattered for any coarse cell to be half known: the cascade stays at
+  // full size rather than start from nothing, and the fill stays within the known colours
+  cv::Mat sparse(40, 40, CV_8UC3), sparse_known(40, 40, CV_8UC1, cv::Scalar(0));
+  cv::randu(sparse, 100, 201);
+  for (int y = 0; y < 40; y += 4)
+    for (int x = 0; x < 40; x += 4) sparse_known.at<uint8_t>(y, x) = 255;
+  HarmonicFill small;
+  small.coarsest_side = 8;
+  const cv::Mat sparse_filled = harmonic_fill(sparse, sparse_known, sparse_known == 0, small);
+  double lo = 0, hi = 0;
+  cv::minMaxLoc(sparse_filled.reshape(1), &lo, &hi);
+  CHECK(lo >= 100);
+  CHECK(hi <= 200);
+
   HarmonicFill bad;
   bad.omega = 2.0f;
   CHECK_THROWS_AS(harmonic_fill(c.image, c.known, hole, bad), std::invalid_argument);

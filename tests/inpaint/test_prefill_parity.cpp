@@ -81,6 +81,9 @@ TEST_CASE("harmonic fill: C++ and the training's numpy port give the same fill",
                           HarmonicFill params;
                           if (f.has("coarsest_side")) params.coarsest_side = int(f.get_int("coarsest_side"));
                           if (f.has("band")) params.band = int(f.get_int("band"));
+                          if (f.has("start_side")) params.start_side = int(f.get_int("start_side"));
+                          if (f.has("coarsest_sweeps")) params.coarsest_sweeps = int(f.get_int("coarsest_sweeps"));
+                          if (f.has("sweeps")) params.sweeps = int(f.get_int("sweeps"));
                           return harmonic_fill(image, known, fill, params, pool);
                         });
   }
