@@ -1,12 +1,13 @@
-"""Push-pull hole filling (inpaint/push_pull.cpp) in numpy, step for step, so the
-inpainting network trains on exactly the pre-fill the C++ filler gives it at inference.
+"""The inpainting network's prefills in numpy, step for step: push-pull
+(inpaint/push_pull.cpp) and the harmonic fill built on it (inpaint/harmonic_fill.cpp),
+so the network trains on exactly the pre-fill the C++ filler gives it at inference.
 
 The C++ version builds a pyramid with cv::resize: INTER_AREA to halve ((n + 1) / 2 per
 side), INTER_LINEAR to come back up. OpenCV is not available to this Python, so both
 resamplings are written here as the weight matrices OpenCV's own tables describe
 (computeResizeAreaTab for INTER_AREA, the half-pixel-centre coefficients with clamped
 edges for INTER_LINEAR) and applied separably, in float32 as OpenCV does. The result is
-rounded to 8 bits like the C++ one. tests/inpaint/test_push_pull_parity.cpp checks the
+rounded to 8 bits like the C++ one. tests/inpaint/test_prefill_parity.cpp checks the
 two agree on fixtures written by this module (`write_fixture`).
 """
 from __future__ import annotations
