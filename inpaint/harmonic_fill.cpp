@@ -113,10 +113,9 @@ void check_params(const HarmonicFill& p) {
         "harmonic_fill: needs 1 <= coarsest_side <= start_side, sweeps and band >= 0, omega in (0, 2)");
 }
 
-// One level of the cascade: start values everywhere (the known colour where known) and
-// the known pixels, which the sweeps keep.
+// One level of the cascade: the known pixels, which the sweeps keep, and their colour.
 struct Level {
-  cv::Mat colour;  // CV_32FC3
+  cv::Mat colour;  // CV_32FC3; only read where known
   cv::Mat known;   // CV_8UC1
 };
 
