@@ -182,9 +182,7 @@ cv::Mat coarsest_start(const std::vector<Level>& levels, int start_side) {
 cv::Mat harmonic_estimate(const cv::Mat& image, const cv::Mat& known, const HarmonicFill& params,
                           ThreadPool& pool) {
   check_params(params);
-  if ((image.type() != CV_8UC3 && image.type() != CV_8UC4) || known.type() != CV_8UC1 ||
-      known.size() != image.size())
-    throw std::invalid_argument("harmonic_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+  check_fill_inputs("harmonic_fill", image, known);
   if (cv::countNonZero(known) == 0) return cv::Mat();  // nothing to spread
   cv::Mat bgr, colour;
   if (image.channels() == 4)
@@ -208,8 +206,7 @@ cv::Mat harmonic_estimate(const cv::Mat& image, const cv::Mat& known, const Harm
 
 cv::Mat harmonic_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill,
                       const HarmonicFill& params, ThreadPool& pool) {
-  if (fill.type() != CV_8UC1 || fill.size() != image.size())
-    throw std::invalid_argument("harmonic_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+  check_fill_inputs("harmonic_fill", image, known, fill);
   const cv::Mat estimate = harmonic_estimate(image, known, params, pool);
   return estimate.empty() ? image.clone() : paste_estimate(image, estimate, fill);
 }

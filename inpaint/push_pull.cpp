@@ -41,13 +41,13 @@ cv::Mat pull(const Level& level, const cv::Mat& coarse_estimate) {
   return level.colour + up.mul(rest3);
 }
 
-void check_fill_inputs(const char* who, const cv::Mat& image, const cv::Mat& known) {
-  if ((image.type() != CV_8UC3 && image.type() != CV_8UC4) || known.type() != CV_8UC1 ||
-      known.size() != image.size())
+}  // namespace
+
+void check_fill_inputs(const char* who, const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill) {
+  const auto is_mask = [&](const cv::Mat& m) { return m.type() == CV_8UC1 && m.size() == image.size(); };
+  if ((image.type() != CV_8UC3 && image.type() != CV_8UC4) || !is_mask(known) || (!fill.empty() && !is_mask(fill)))
     throw std::invalid_argument(std::string(who) + ": expects 8-bit BGR(A) image and 8-bit masks of its size");
 }
-
-}  // namespace
 
 cv::Mat push_pull_estimate(const cv::Mat& image, const cv::Mat& known) {
   if (image.type() != CV_32FC3) check_fill_inputs("push_pull_estimate", image, known);
@@ -93,9 +93,7 @@ cv::Mat paste_estimate(const cv::Mat& image, const cv::Mat& estimate, const cv::
 }
 
 cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill) {
-  check_fill_inputs("push_pull_fill", image, known);
-  if (fill.type() != CV_8UC1 || fill.size() != image.size())
-    throw std::invalid_argument("push_pull_fill: expects 8-bit BGR(A) image and 8-bit masks of its size");
+  check_fill_inputs("push_pull_fill", image, known, fill);
   const cv::Mat estimate = push_pull_estimate(image, known);
   return estimate.empty() ? image.clone() : paste_estimate(image, estimate, fill);
 }

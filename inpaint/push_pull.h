@@ -13,6 +13,11 @@ namespace ampi {
 // fill != 0 are replaced by the push-pull estimate; every other pixel is unchanged.
 cv::Mat push_pull_fill(const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill);
 
+// Throws std::invalid_argument "WHO: expects 8-bit BGR(A) image and 8-bit masks of its
+// size" unless image is CV_8UC3 or CV_8UC4 and known (and fill, unless empty) CV_8UC1 of
+// its size: the inputs every filler takes.
+void check_fill_inputs(const char* who, const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill = cv::Mat());
+
 // The float estimate behind push_pull_fill: CV_32FC3 at every pixel (the known colour
 // where known), from an 8-bit BGR(A) or a CV_32FC3 image. Empty when no pixel is known.
 cv::Mat push_pull_estimate(const cv::Mat& image, const cv::Mat& known);

@@ -105,12 +105,16 @@ def push_pull_float(rgb: np.ndarray, known: np.ndarray) -> np.ndarray:
 def push_pull_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray, **_params) -> np.ndarray:
     """As ampi::push_pull_fill: image uint8 [H, W, 3]; the pixels where fill is set take the
     8-bit push-pull estimate from the known pixels, every other pixel is unchanged."""
-    estimate = push_pull_float(image, known)
-    if estimate is None:
-        return image.copy()
-    filled = np.clip(np.rint(estimate), 0, 255).astype(np.uint8)
+    return paste_estimate(image, push_pull_float(image, known), fill)
+
+
+def paste_estimate(image: np.ndarray, estimate, fill: np.ndarray) -> np.ndarray:
+    """As ampi::paste_estimate: a copy of image whose pixels where fill is set take the
+    8-bit rounding of estimate (None: nothing was known, image unchanged)."""
     out = image.copy()
-    out[fill > 0] = filled[fill > 0]
+    if estimate is not None:
+        filled = np.clip(np.rint(estimate), 0, 255).astype(np.uint8)
+        out[fill > 0] = filled[fill > 0]
     return out
 
 
@@ -204,13 +208,7 @@ def harmonic_fill(image: np.ndarray, known: np.ndarray, fill: np.ndarray, **para
     """As ampi::harmonic_fill: image uint8 [H, W, 3]; the pixels where fill is set take the
     8-bit harmonic estimate from the known pixels (params: harmonic_float's), every other
     pixel is unchanged."""
-    estimate = harmonic_float(image, known, **params)
-    if estimate is None:
-        return image.copy()
-    filled = np.clip(np.rint(estimate), 0, 255).astype(np.uint8)
-    out = image.copy()
-    out[fill > 0] = filled[fill > 0]
-    return out
+    return paste_estimate(image, harmonic_float(image, known, **params), fill)
 
 
 PREFILLS = {"push-pull": push_pull_fill, "harmonic": harmonic_fill}  # by inpaint.prefill name
