@@ -9,6 +9,7 @@
 #include "slicing/bilateral.h"
 #include "slicing/edges.h"
 #include "slicing/level_stats.h"
+#include "slicing/optimal_cuts.h"
 
 namespace ampi {
 namespace {
@@ -20,6 +21,7 @@ void check_params(const SlicingParams& p) {
   require(p.max_planes >= 1 && p.max_planes <= kDisparityLevels - 1, "max_planes must be in 1..255");
   require(p.eps > 0, "eps must be positive");
   require(p.xi >= 0, "xi must not be negative");
+  require(p.tear_penalty >= 0, "tear_penalty must not be negative");
   require(p.min_plane_share >= 0 && p.min_plane_share <= 1, "min_plane_share must be in [0, 1]");
   require(p.bilateral_diameter >= 1, "bilateral_diameter must be at least 1");
   require(p.bilateral_sigma_color > 0 && p.bilateral_sigma_space > 0, "bilateral sigmas must be positive");
@@ -30,7 +32,21 @@ void check_params(const SlicingParams& p) {
 // Mass of h over the levels [lo, end), from prefix sums (prefix[i] = h[0] + .. + h[i-1]).
 double mass(const std::vector<double>& prefix, int lo, int end) { return prefix[end] - prefix[lo]; }
 
+// Cost of cutting at each level: tear_penalty times the pixels of h on both sides of the
+// cut, halved (h is normalised to 1: scaled back to pixels).
+std::vector<double> tear_costs(const std::vector<double>& h, double tear_penalty, size_t pixels) {
+  std::vector<double> cost(h.size(), 0.0);
+  for (size_t c = 1; c < h.size(); ++c) cost[c] = tear_penalty * 0.5 * (h[c - 1] + h[c]) * static_cast<double>(pixels);
+  return cost;
+}
+
 }  // namespace
+
+Slicer parse_slicer(const std::string& name) {
+  if (name == "paper") return Slicer::Paper;
+  if (name == "optimal") return Slicer::Optimal;
+  throw std::runtime_error("--slicer: '" + name + "' is not paper or optimal");
+}
 
 cv::Mat normalize_disparity_float(const cv::Mat& disparity) {
   cv::Mat values;
@@ -136,7 +152,9 @@ std::vector<Plane> slice_adaptive(const cv::Mat& disparity, const SlicingParams&
   const std::vector<double> t = transition_index(h, p.eps);
   const std::vector<int> selected = select_transitions(t, h, p.xi, p.threshold, p.max_planes - 1,
                                                          p.min_plane_share / p.max_planes);
-  const std::vector<int> b = plane_boundaries(selected, stats.count);
+  std::vector<int> b = plane_boundaries(selected, stats.count);
+  if (p.slicer == Slicer::Optimal)
+    b = optimal_boundaries(stats.count, static_cast<int>(b.size()) - 1, tear_costs(h, p.tear_penalty, disparity.total()));
   std::vector<Plane> planes;
   for (size_t j = 0; j + 1 < b.size(); ++j) planes.push_back(plane_for_interval(stats, b[j], b[j + 1], p.range));
   return planes;

@@ -9,6 +9,7 @@
 // follows from the DepthRange through depth_from_disparity.
 #pragma once
 #include <opencv2/core.hpp>
+#include <string>
 #include <vector>
 
 #include "mpi/mpi.h"
@@ -17,12 +18,30 @@ namespace ampi {
 
 constexpr int kDisparityLevels = 256;
 
+// How slice_adaptive places its cuts. Both run the paper's pipeline up to the greedy
+// selection of transitions.
+enum class Slicer {
+  // The paper's algorithm: the selected transitions are the cuts.
+  Paper,
+  // The paper's selection decides how many planes the photo gets (the cuts it would make);
+  // the cuts themselves then minimise the planes' squared disparity error over all pixels
+  // (slicing/optimal_cuts.h). Beyond the paper: its transition index is largest where the
+  // histogram is sparse, so it cuts off slivers at the ends and leaves one plane spanning
+  // most of the disparity range (bench/RESULTS-slicing.md), while every pixel of a plane
+  // moves with the plane's mean disparity.
+  Optimal,
+};
+
+// "paper" or "optimal" (the --slicer values); throws std::runtime_error otherwise.
+Slicer parse_slicer(const std::string& name);
+
 // Every constant of the adaptive algorithm. eps, xi and threshold are the paper's
 // values; the paper gives no filter sizes, so these defaults are ours. On the 0..255
 // map the 3x3 Sobel response is 4 s across a step of s levels and 8 r along a slope of
 // r levels per pixel: an edge starts at a step of about 13 levels (canny_high) and
 // continues down to 5 (canny_low), while slopes under 2.5 levels per pixel never count.
 struct SlicingParams {
+  Slicer slicer = Slicer::Optimal;
   int max_planes = 8;         // at most this many planes, 1..255 (the paper's maximum count)
   double eps = 0.001;         // floor of h in the transition index's denominator
   int xi = 8;                 // a chosen transition suppresses t in [i - xi, i + xi]
@@ -30,8 +49,15 @@ struct SlicingParams {
   // Beyond the paper: every plane must hold more than this fraction of an equal share
   // (1 / max_planes) of the histogram's mass, so no plane is a sliver of the sparse ends
   // (select_transitions' min_mass). 0 gives the paper's algorithm, which only refuses
-  // to cut off an empty interval.
-  double min_plane_share = 0.5;
+  // to cut off an empty interval. With Slicer::Optimal it only changes the plane count.
+  // (0.5 made the paper's cuts lose less to uniform ones; the optimal cuts need no guard.)
+  double min_plane_share = 0.0;
+  // Slicer::Optimal: a cut at level c also costs tear_penalty * (pixels of h at levels
+  // c - 1 and c) / 2, in squared levels per pixel. A cut through a continuous surface opens
+  // a crack along it as the camera moves, about as long as the surface has pixels at
+  // the cut; h leaves depth edges out, where a cut opens nothing that is not already open.
+  // 0: on the tuning photos every penalty tried lowered PSNR (bench/RESULTS-slicing.md).
+  double tear_penalty = 0.0;
   int bilateral_diameter = 5;           // pixel neighbourhood of the bilateral filter
   double bilateral_sigma_color = 20.0;  // in disparity levels
   double bilateral_sigma_space = 3.0;   // in pixels
@@ -48,7 +74,8 @@ cv::Mat normalize_disparity(const cv::Mat& disparity);
 // The same normalisation without rounding: CV_32FC1 in [0, 255].
 cv::Mat normalize_disparity_float(const cv::Mat& disparity);
 
-// The paper's algorithm. Throws std::invalid_argument for a bad map or bad params.
+// The paper's algorithm, its cuts placed as p.slicer says. Throws std::invalid_argument
+// for a bad map or bad params.
 std::vector<Plane> slice_adaptive(const cv::Mat& disparity, const SlicingParams& p = {});
 
 // `planes` equal intervals of normalised disparity (1..255 of them). A plane that holds

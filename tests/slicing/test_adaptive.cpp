@@ -230,12 +230,13 @@ TEST_CASE("a smooth ramp gives few planes") {
   check_plane_structure(planes, d);
 }
 
-TEST_CASE("the maximum count and xi spacing hold on random smooth maps") {
+TEST_CASE("the maximum count and xi spacing hold on random smooth maps (the paper's slicer)") {
   for (uint32_t seed = 1; seed <= 12; ++seed) {
     const cv::Mat d = random_smooth_map(120, 90, seed);
     for (int max_planes : {1, 2, 3, 5, 8}) {
       for (int xi : {0, 4, 8, 16}) {
         SlicingParams p;
+        p.slicer = Slicer::Paper;
         p.max_planes = max_planes;
         p.xi = xi;
         INFO("seed " << seed << ", max_planes " << max_planes << ", xi " << xi);
@@ -247,6 +248,68 @@ TEST_CASE("the maximum count and xi spacing hold on random smooth maps") {
       }
     }
   }
+}
+
+// Summed squared error, in levels, of the pixels of `levels` (CV_8UC1) to their plane's
+// mean level.
+double quantization_error(const std::vector<Plane>& planes, const cv::Mat& levels) {
+  std::vector<double> sum(planes.size(), 0.0), sum2(planes.size(), 0.0), n(planes.size(), 0.0);
+  for (auto it = levels.begin<uchar>(); it != levels.end<uchar>(); ++it) {
+    const int j = plane_of_level(planes, *it);
+    REQUIRE(j >= 0);
+    n[j] += 1, sum[j] += *it, sum2[j] += double(*it) * *it;
+  }
+  double error = 0;
+  for (size_t j = 0; j < planes.size(); ++j)
+    if (n[j] > 0) error += sum2[j] - sum[j] * sum[j] / n[j];
+  return error;
+}
+
+TEST_CASE("the optimal slicer makes the paper's count with no more error than its cuts or equal intervals") {
+  for (uint32_t seed = 1; seed <= 12; ++seed) {
+    const cv::Mat d = random_smooth_map(120, 90, seed);
+    const cv::Mat levels = normalize_disparity(d);
+    for (int max_planes : {2, 4, 8, 16}) {
+      SlicingParams p;
+      p.max_planes = max_planes;
+      p.slicer = Slicer::Paper;
+      const std::vector<Plane> paper = slice_adaptive(d, p);
+      p.slicer = Slicer::Optimal;
+      const std::vector<Plane> optimal = slice_adaptive(d, p);
+      const std::vector<Plane> uniform = slice_uniform(d, static_cast<int>(optimal.size()));
+      INFO("seed " << seed << ", max_planes " << max_planes);
+      check_plane_structure(optimal, d);
+      CHECK(optimal.size() == paper.size());
+      const double error = quantization_error(optimal, levels);
+      CHECK(error <= quantization_error(paper, levels) * (1 + 1e-9));
+      CHECK(error <= quantization_error(uniform, levels) * (1 + 1e-9));
+    }
+  }
+}
+
+TEST_CASE("a tear penalty moves the optimal cuts off populated levels of h") {
+  for (uint32_t seed = 1; seed <= 8; ++seed) {
+    const cv::Mat d = random_smooth_map(120, 90, seed);
+    SlicingParams p;
+    const std::vector<double> h = slicing_histogram(normalize_disparity(d), p);
+    auto torn = [&](const std::vector<Plane>& planes) {
+      double sum = 0;
+      for (int c : interior_boundaries(planes)) sum += h[c - 1] + h[c];
+      return sum;
+    };
+    const std::vector<Plane> free_cuts = slice_adaptive(d, p);
+    p.tear_penalty = 1e4;
+    const std::vector<Plane> careful = slice_adaptive(d, p);
+    INFO("seed " << seed);
+    CHECK(careful.size() == free_cuts.size());
+    CHECK(torn(careful) <= torn(free_cuts));
+  }
+}
+
+TEST_CASE("parse_slicer knows paper and optimal") {
+  CHECK(parse_slicer("paper") == Slicer::Paper);
+  CHECK(parse_slicer("optimal") == Slicer::Optimal);
+  CHECK_THROWS_WITH(parse_slicer("greedy"), Catch::Contains("not paper or optimal"));
 }
 
 TEST_CASE("a constant map gives one plane") {
@@ -322,4 +385,7 @@ TEST_CASE("bad disparity maps and parameters are refused") {
   p = {};
   p.border_erosion_size = 0;
   CHECK_THROWS_WITH(slice_adaptive(ok, p), Catch::Contains("border_erosion_size"));
+  p = {};
+  p.tear_penalty = -1;
+  CHECK_THROWS_WITH(slice_adaptive(ok, p), Catch::Contains("tear_penalty"));
 }

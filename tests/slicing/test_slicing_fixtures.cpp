@@ -1,12 +1,13 @@
-// The transition index and the greedy selection against the independent numpy reference
-// in tests/fixtures/slicing/make_slicing_fixtures.py (same histograms in, t and the
-// chosen indices out).
+// The transition index, the greedy selection and the optimal cuts against the independent
+// numpy reference in tests/fixtures/slicing/make_slicing_fixtures.py (same histograms in,
+// t, the chosen indices and the optimal boundaries out).
 #include <catch2/catch.hpp>
 #include <cmath>
 #include <string>
 #include <vector>
 
 #include "slicing/adaptive.h"
+#include "slicing/optimal_cuts.h"
 #include "weights_format/npy.h"
 
 using namespace ampi;
@@ -50,5 +51,25 @@ TEST_CASE("transition index and selection match the numpy reference") {
     for (double v : row(selected, c))
       if (v >= 0) expected.push_back(static_cast<int>(v));
     CHECK(select_transitions(t, h, xi, threshold, max_selected) == expected);
+  }
+}
+
+TEST_CASE("optimal cuts match the numpy reference for the count the selection makes") {
+  const Tensor counts = fixture("counts.npy"), selected = fixture("selected.npy"), optimal = fixture("optimal.npy");
+  REQUIRE(counts.rank() == 2);
+  REQUIRE(counts.dim(1) == kDisparityLevels);
+  REQUIRE(counts.dim(0) >= 10);
+  REQUIRE(selected.dim(0) == counts.dim(0));
+  REQUIRE(optimal.dim(0) == counts.dim(0));
+  for (int64_t c = 0; c < counts.dim(0); ++c) {
+    std::vector<long long> pixels;
+    for (double v : row(counts, c)) pixels.push_back(static_cast<long long>(v));  // exact: below 2^24
+    int planes = 1;
+    for (double v : row(selected, c)) planes += v >= 0;
+    std::vector<int> expected;
+    for (double v : row(optimal, c))
+      if (v >= 0) expected.push_back(static_cast<int>(v));
+    INFO("fixture case " << c << ", " << planes << " planes");
+    CHECK(optimal_boundaries(pixels, planes) == expected);
   }
 }
