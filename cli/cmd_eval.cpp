@@ -271,7 +271,8 @@ const char kSlicingUsage[] =
     "usage: ampi eval slicing --images DIR [--counts 4,8,16] [--reference-planes N] [--poses N]\n"
     "                         [--amplitude A] [--max-size N] [--model lite|heavy | --weights FILE]\n"
     "                         [--working-size N] [--depth-dir D] [--inpainter push-pull|network]\n"
-    "                         [--min-plane-share F] [--limit N] [--threads N]\n"
+    "                         [--slicer paper|optimal] [--min-plane-share F] [--tear-penalty P]\n"
+    "                         [--limit N] [--threads N]\n"
     "\n"
     "The paper's Table 3 (Luvizon et al., WACV 2021: adaptive against uniform slicing, SSIM and\n"
     "PSNR of novel views) on every photo under DIR (.jpg, .jpeg, .png, recursively, sorted).\n"
@@ -279,8 +280,9 @@ const char kSlicingUsage[] =
     "with those of a densely sampled MPI. Per photo (scaled down to --max-size) and per\n"
     "maximum plane count N, three MPIs from the same depth (our network, or --depth-dir), the same slicing\n"
     "depth range and the same inpainting:\n"
-    "  adaptive   the paper's adaptive slicing with the plane guard (--min-plane-share), at\n"
-    "             most N planes (it makes n)\n"
+    "  adaptive   adaptive slicing (--slicer: the paper's rule decides the count, the cuts\n"
+    "             minimise the squared disparity error; or the paper's cuts), at most N\n"
+    "             planes (it makes n)\n"
     "  uniform    equal disparity intervals, n planes: the count adaptive made for the photo\n"
     "             (empty intervals are dropped, so it may hold fewer)\n"
     "  reference  equal disparity intervals, --reference-planes planes\n"
@@ -301,8 +303,11 @@ const char kSlicingUsage[] =
     "  --depth-dir D           depth maps instead of the network: the one file D/sub/name.* for\n"
     "                          DIR/sub/name.jpg, any format ampi run --depth reads, larger = nearer\n"
     "  --inpainter I           push-pull (default) or network (weights/inpaint.ampw; ampi run's default)\n"
-    "  --min-plane-share F     the adaptive slicer's guard: each plane holds more than F/N of the\n"
-    "                          depth histogram (default 0.5; 0: the paper's rule exactly)\n"
+    "  --slicer S              optimal (default) or paper, as ampi slice --slicer\n"
+    "  --min-plane-share F     the paper's rule takes a cut only if each plane keeps more than\n"
+    "                          F/N of the depth histogram (default 0: the paper's rule exactly)\n"
+    "  --tear-penalty P        optimal slicer: a cut also costs P squared levels per pixel of the\n"
+    "                          edge-free depth histogram at the cut (default 0)\n"
     "  --limit N               only the first N photos\n"
     "  --threads N             worker threads (default: all hardware threads)\n";
 
@@ -375,7 +380,9 @@ int eval_slicing(int argc, char** argv) {
     if (v != "push-pull" && v != "network") throw std::runtime_error("--inpainter: '" + v + "' is not push-pull or network");
     a.inpainter = v;
   });
+  p.option("--slicer", [&](const std::string& v) { a.options.slicer = parse_slicer(v); });
   p.option("--min-plane-share", &a.options.min_plane_share, 0.0, 1.0);
+  p.option("--tear-penalty", &a.options.tear_penalty, 0.0, 1e9);
   p.option("--limit", &a.limit, 0, 1 << 30);
   p.option("--threads", &a.threads, 0, 1024);
   if (!p.parse(argc, argv)) return 0;

@@ -51,8 +51,14 @@ const char kUsage[] =
     "                          file asks for; layers are always cut at full resolution)\n"
     "  --max-planes N          at most N planes (default 8)\n"
     "  --uniform               equal disparity intervals (the paper's baseline)\n"
-    "  --min-plane-share F     adaptive cuts leave each plane more than F/N of the depth\n"
-    "                          histogram, N = --max-planes (default 0.5; 0: the paper's rule)\n"
+    "  --slicer S              optimal (default): the paper's rule decides how many planes,\n"
+    "                          the cuts minimise the planes' squared disparity error; paper:\n"
+    "                          the paper's cuts (its largest transition indices)\n"
+    "  --min-plane-share F     the paper's rule takes a cut only if each plane keeps more than\n"
+    "                          F/N of the depth histogram, N = --max-planes (default 0: the\n"
+    "                          paper's rule exactly)\n"
+    "  --tear-penalty P        optimal slicer: a cut also costs P squared levels per pixel of the\n"
+    "                          edge-free depth histogram at the cut (default 0)\n"
     "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
     "  --inpainter NAME        what fills occluded margins: network (default), harmonic (as close\n"
     "                          to the truth, no texture, faster) or push-pull (fastest)\n"
@@ -102,7 +108,9 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--working-size", &a.mpi.working_size, kMinPhotoSide, 16384);
   p.option("--max-planes", &a.mpi.slicing.max_planes, 1, kDisparityLevels - 1);
   p.flag("--uniform", &a.mpi.uniform);
+  p.option("--slicer", [&](const std::string& v) { a.mpi.slicing.slicer = parse_slicer(v); });
   p.option("--min-plane-share", &a.mpi.slicing.min_plane_share, 0.0, 1.0);
+  p.option("--tear-penalty", &a.mpi.slicing.tear_penalty, 0.0, 1e9);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
   p.option("--inpainter", [&](const std::string& v) { a.mpi.inpainter = parse_inpainter(v); });

@@ -91,7 +91,9 @@ std::vector<SlicingScore> SlicingEvaluator::add(const cv::Mat& bgr, const cv::Ma
   for (int count : options_.counts) {
     SlicingParams params;
     params.max_planes = count;
+    params.slicer = options_.slicer;
     params.min_plane_share = options_.min_plane_share;
+    params.tear_penalty = options_.tear_penalty;
     params.range = options_.range;
     const std::vector<Plane> adaptive = slice_adaptive(disparity, params);
     rows.push_back(score(count, "uniform", slice_uniform(disparity, int(adaptive.size()), options_.range)));

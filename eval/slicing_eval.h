@@ -5,7 +5,8 @@
 // exist it compares "the views produced by our adaptive slicing method with a densely
 // sampled MPI projected to the target view point"; that is what is done here, since
 // photos carry no second view. Per photo, for every maximum plane count N:
-//   - adaptive: slice_adaptive with max_planes = N; it makes n <= N planes;
+//   - adaptive: slice_adaptive with max_planes = N and the chosen slicer; it makes n <= N
+//               planes;
 //   - uniform:  slice_uniform with n planes, the count adaptive actually produced (the
 //               paper's "uniform slicing was performed with the number of planes resulting
 //               from our method"); empty uniform planes are dropped, so it may hold fewer;
@@ -41,7 +42,9 @@ struct SlicingEvalOptions {
   double amplitude = 0.05;               // circle radius / nearest reference plane depth, in (0, 1)
   double fov_degrees = 60;               // assumed horizontal field of view
   DepthRange range;                      // where normalised disparity puts the planes
+  Slicer slicer = SlicingParams{}.slicer;                    // how the adaptive slicer cuts
   double min_plane_share = SlicingParams{}.min_plane_share;  // the adaptive slicer's guard
+  double tear_penalty = SlicingParams{}.tear_penalty;        // its cost of cutting a surface
 };
 
 // One row of the table: a count and a method, averaged over photos.

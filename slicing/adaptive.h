@@ -56,7 +56,8 @@ struct SlicingParams {
   // c - 1 and c) / 2, in squared levels per pixel. A cut through a continuous surface opens
   // a crack along it as the camera moves, about as long as the surface has pixels at
   // the cut; h leaves depth edges out, where a cut opens nothing that is not already open.
-  // 0: on the tuning photos every penalty tried lowered PSNR (bench/RESULTS-slicing.md).
+  // 0: on the tuning photos 100 and 1000 lowered PSNR at 8 and 16 planes
+  // (bench/RESULTS-slicing.md).
   double tear_penalty = 0.0;
   int bilateral_diameter = 5;           // pixel neighbourhood of the bilateral filter
   double bilateral_sigma_color = 20.0;  // in disparity levels

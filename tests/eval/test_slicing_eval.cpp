@@ -58,6 +58,25 @@ TEST_CASE("with a plane per step, adaptive and uniform render the reference's vi
   CHECK(rows[0].planes == rows[1].planes);  // uniform gets the count adaptive made
 }
 
+TEST_CASE("the adaptive rows follow the chosen slicer, the uniform ones its count", "[eval][slicing]") {
+  // Eight equally populated steps in four planes: the optimal cuts pair neighbouring steps,
+  // as equal intervals do, so both MPIs are the same; the paper's cuts group them otherwise.
+  SlicingEvalOptions options = small_options({4});
+  const cv::Mat bgr = photo(96, 64), disparity = staircase(96, 64, 8);
+  options.slicer = Slicer::Optimal;
+  const std::vector<SlicingScore> optimal = SlicingEvaluator(options, push_pull_filler()).add(bgr, disparity);
+  options.slicer = Slicer::Paper;
+  const std::vector<SlicingScore> paper = SlicingEvaluator(options, push_pull_filler()).add(bgr, disparity);
+  REQUIRE(optimal.size() == 2);
+  REQUIRE(paper.size() == 2);
+  CHECK(optimal[1].planes == 4);
+  CHECK(paper[1].planes == 4);
+  CHECK(optimal[1].psnr == optimal[0].psnr);  // optimal cuts = equal intervals here
+  CHECK(optimal[1].ssim == optimal[0].ssim);
+  CHECK(paper[0].psnr == optimal[0].psnr);  // uniform: the same count, the same MPI
+  CHECK(paper[1].psnr != optimal[1].psnr);
+}
+
 TEST_CASE("the means are over photos", "[eval][slicing]") {
   SlicingEvaluator eval(small_options({4}), push_pull_filler());
   const std::vector<SlicingScore> a = eval.add(photo(64, 48), staircase(64, 48, 2));

@@ -1,6 +1,6 @@
 #!/bin/sh
-# ampi slice on a depth map with three flat levels: three planes by default, at most two
-# with --max-planes 2, at most four uniform ones; bad input exits non-zero with one line
+# ampi slice on a depth map with three flat levels: three planes by default and with
+# either slicer, at most two with --max-planes 2, at most four uniform ones; bad input exits non-zero with one line
 # on stderr naming the file.
 #   usage: slice_cli.sh AMPI_BINARY THREE_LEVEL_PNG
 set -u
@@ -42,6 +42,8 @@ planes "three levels" 3 3 "$depth"
 planes "max planes 2" 1 2 "$depth" --max-planes 2
 planes "uniform 4" 1 4 "$depth" --uniform --max-planes 4
 planes "as distances" 3 3 "$depth" --depth-is-distance
+planes "paper slicer" 3 3 "$depth" --slicer paper
+planes "tear penalty" 3 3 "$depth" --tear-penalty 100
 "$ampi" slice --help >"$tmp/out" || fail "--help: exit status $?"
 grep -q "usage: ampi slice" "$tmp/out" || fail "--help: no usage text"
 
@@ -50,5 +52,8 @@ expect_error missing "$tmp/missing.png: no such file" "$tmp/missing.png"
 expect_error unreadable "$tmp/text.png: not a readable image" "$tmp/text.png"
 expect_error "bad max planes" "--max-planes" "$depth" --max-planes 0
 expect_error "unknown option" "unknown option '--planes'" "$depth" --planes 3
+expect_error "bad slicer" "--slicer: 'greedy' is not paper or optimal" "$depth" --slicer greedy
+expect_error "bad share" "--min-plane-share: '2' is not a number in 0..1" "$depth" --min-plane-share 2
+expect_error "bad tear penalty" "--tear-penalty: '-1' is not a number in 0..1e+09" "$depth" --tear-penalty -1
 
 [ "$failures" -eq 0 ]
