@@ -8,8 +8,9 @@ depth: 50 synthetic validation scenes (training/make_eval_scenes.py: exact dispa
 textured with validation photos only), `ampi eval depth` with the lite and the heavy
 network. slicing: the validation photos (every tenth photo by sorted name of each folder
 of ../shared/data/photos, training/scenes.py photo_split), `ampi eval slicing` with the
-default plane guard and with the paper's rule exactly; the guard's tuning runs on
-training photos; the same on 50 synthetic scenes with their exact depth.
+default (optimal) slicer, with the paper's rule exactly and with its former plane guard;
+the tear penalty's tuning runs on training photos; the default on 50 synthetic scenes
+with their exact depth.
 The tables quote ampi's output verbatim, with the command that made it.
 """
 
@@ -114,14 +115,37 @@ def verdict_of(out):
     return lines[0] if lines else '?'
 
 
-TUNING_SHARES = ('0', '0.5', '1')  # --min-plane-share values compared on the tuning photos
+TUNING_TEAR_PENALTIES = ('0', '100', '1000')  # --tear-penalty values compared on the tuning photos
+
+
+def adaptive_minus_uniform(runs, label):
+    """Markdown rows: per run and count, adaptive's planes and its SSIM and PSNR above uniform's."""
+    lines = [f'| {label} | count | planes | SSIM difference | PSNR difference (dB) |', '|---|---:|---:|---:|---:|']
+    for value, out, _ in runs:
+        rows = slicing_rows(out)
+        for count in sorted({c for c, _ in rows}):
+            a, u = rows[(count, 'adaptive')], rows[(count, 'uniform')]
+            lines.append(f'| {value} | {count} | {a[0]:.2f} | {a[1] - u[1]:+.4f} | {a[2] - u[2]:+.3f} |')
+    return lines
+
+
+def penalty_effect(tuning):
+    """How adaptive's mean PSNR changes, count by count, from the first tuning run to each other one."""
+    base = slicing_rows(tuning[0][1])
+    parts = []
+    for penalty, out, _ in tuning[1:]:
+        rows = slicing_rows(out)
+        changes = ', '.join(f'{rows[(c, "adaptive")][2] - base[(c, "adaptive")][2]:+.3f} dB at {c}'
+                            for c, m in sorted(base) if m == 'adaptive')
+        parts.append(f"a penalty of {penalty} changes adaptive's mean PSNR by {changes}")
+    return '; '.join(parts)
 
 
 def slicing_table(ampi, threads, scene_count, extra):
     import scenes
     root = scenes.photo_root()
     photos = scenes.list_photos('val')
-    # Where the guard's default was chosen: training photos only, never the validation ones.
+    # Where the tear penalty was chosen: training photos only, never the validation ones.
     tuning_photos = scenes.list_photos('train')[5::10]
     eval_slicing = [ampi, 'eval', 'slicing', '--threads', str(threads)] + extra
     with tempfile.TemporaryDirectory(prefix='ampi-eval-slicing-') as tmp:
@@ -131,18 +155,20 @@ def slicing_table(ampi, threads, scene_count, extra):
         command = eval_slicing + ['--images', val_dir]
         out, seconds = run(command)
         command = shown(command).replace(str(val_dir), 'VAL_PHOTOS')
-        paper_command = command + ' --min-plane-share 0'
-        paper_out, paper_seconds = run(eval_slicing + ['--images', val_dir, '--min-plane-share', '0'])
+        paper_flags = ['--slicer', 'paper']
+        guard_flags = paper_flags + ['--min-plane-share', '0.5']
+        paper_out, paper_seconds = run(eval_slicing + ['--images', val_dir] + paper_flags)
+        guard_out, guard_seconds = run(eval_slicing + ['--images', val_dir] + guard_flags)
         tuning = []
-        for share in TUNING_SHARES:
-            tuning_out, tuning_seconds = run(eval_slicing + ['--images', tuning_dir, '--min-plane-share', share])
-            tuning.append((share, tuning_out, tuning_seconds))
+        for penalty in TUNING_TEAR_PENALTIES:
+            tuning_out, tuning_seconds = run(eval_slicing + ['--images', tuning_dir, '--tear-penalty', penalty])
+            tuning.append((penalty, tuning_out, tuning_seconds))
         example = val_dir / photos[0].relative_to(root)
         depth_png = Path(tmp) / 'example_depth.png'
         run([ampi, 'depth', example, '-o', depth_png])
         example_cuts = {kind: run([ampi, 'slice', depth_png, '--max-planes', '4'] + flag)[0]
-                        for kind, flag in (('adaptive, the paper\'s rule (--min-plane-share 0)', ['--min-plane-share', '0']),
-                                           ('adaptive (default guard)', []), ('uniform', ['--uniform']))}
+                        for kind, flag in (('the paper\'s cuts (--slicer paper)', paper_flags),
+                                           ('optimal cuts (default)', []), ('uniform', ['--uniform']))}
         example_name = str(photos[0].relative_to(root))
     with tempfile.TemporaryDirectory(prefix='ampi-eval-slicing-scenes-') as tmp:
         write_scenes(tmp, scene_count)
@@ -165,27 +191,39 @@ def slicing_table(ampi, threads, scene_count, extra):
         'count, an adaptive MPI, a uniform MPI with the number of planes adaptive made, and a',
         'densely sampled uniform reference MPI, all from the bundled lite depth network and',
         'push-pull inpainting, rendered at the same target poses; SSIM and PSNR against the',
-        "reference's views. The paper (section \"Evaluation metrics\") compares with \"a densely",
+        'reference\'s views. The paper (section "Evaluation metrics") compares with "a densely',
         'sampled MPI projected to the target view point" where it has no second view, as here;',
         'its Table 3 itself uses RealEstate10K target frames, so the numbers are not comparable',
         'to the paper\'s (it reports SSIM 0.67-0.68, PSNR 18.7-19.0 dB).',
         '',
-        'Adaptive here is the paper\'s algorithm with one guard (`SlicingParams::min_plane_share`,',
-        'default 0.5): a transition is taken only if every plane keeps more than half an equal',
-        'share (0.5 / N of the depth histogram for at most N planes). Why it is there, and how',
-        'the 0.5 was chosen, below.',
+        'Adaptive here is the default slicer, `--slicer optimal` (`slicing/optimal_cuts.h`): the',
+        'paper\'s pipeline (bilateral filter, Canny edges, eroded borders, edge-aware histogram,',
+        'transition index, greedy selection with its threshold) decides how many planes a photo',
+        'gets; the cuts are then placed by exact dynamic programming over the 256 disparity',
+        'levels to minimise the planes\' summed squared disparity error over all pixels (each',
+        'pixel is drawn at its plane\'s mean disparity, so this is what moves it away from the',
+        'dense reference). That is optimal 1-D quantisation (Jenks natural breaks, solved',
+        'exactly): uniform intervals with the same count are one of the candidates, so their',
+        'squared disparity error is never lower (`tests/slicing/test_optimal_cuts.cpp`).',
         '',
         '## The paper\'s rule exactly',
         '',
-        f'`{paper_command}` ({paper_seconds:.0f} s)',
+        f'`{command} {shown(paper_flags)}` ({paper_seconds:.0f} s)',
         '',
         *fenced(paper_out),
         '',
-        '## Why the paper\'s rule loses here, and the guard',
+        'And with the guard that was the default before the optimal slicer (a transition is',
+        'taken only if every plane keeps more than 0.5 / N of the depth histogram):',
+        '',
+        f'`{command} {shown(guard_flags)}` ({guard_seconds:.0f} s)',
+        '',
+        *fenced(guard_out),
+        '',
+        '## Why the paper\'s cuts lose here',
         '',
         f'The planes of the first validation photo, `{example_name}`, with the lite network\'s depth',
         f'(`ampi depth VAL_PHOTOS/{example_name} -o D.png`, then `ampi slice D.png --max-planes 4`',
-        'with `--min-plane-share 0`, with the default, and with `--uniform`):',
+        'with `--slicer paper`, with the default, and with `--uniform`):',
         '',
         '```',
     ]
@@ -198,34 +236,28 @@ def slicing_table(ampi, threads, scene_count, extra):
         'largest where few pixels are: on a smooth depth map the sparse ends draw the cuts, leaving',
         'slivers of a few hundred pixels while one plane holds most of the pixels over a wide',
         'disparity interval. A dense reference penalises exactly that (every pixel of a plane',
-        'moves with the plane\'s mean disparity), while uniform intervals bound the error for every',
-        'pixel. The guard refuses a cut that would leave a plane with 0.5 / N of the histogram or',
-        'less; the paper\'s transition index still chooses among the cuts it allows, and the',
-        'plane count still adapts (below N when no allowed transition is above the threshold).',
+        'moves with the plane\'s mean disparity). The optimal cuts keep the paper\'s count and',
+        'spend the planes where the pixels are.',
         '',
-        f'The default was chosen on {len(tuning_photos)} training photos (every tenth of the training',
+        '## The tear penalty',
+        '',
+        'A cut through a continuous surface also opens a crack along it when the camera moves;',
+        'the paper\'s edge-aware histogram h (depth edges left out) measures how much surface a',
+        'cut at a level goes through, and the optimal slicer can charge for it',
+        '(`SlicingParams::tear_penalty`, `--tear-penalty P`: P squared levels per pixel of h at',
+        f'the cut). It was chosen on {len(tuning_photos)} training photos (every tenth of the training',
         'split, from the sixth; never the validation photos above), with the same command and',
-        '`--min-plane-share` 0, 0.5 and 1:',
+        f'`--tear-penalty` {", ".join(TUNING_TEAR_PENALTIES)}:',
         '',
     ]
-    for share, tuning_out, tuning_seconds in tuning:
-        lines += [f'`--min-plane-share {share}` ({tuning_seconds:.0f} s):', '', *fenced(tuning_out), '']
+    for penalty, tuning_out, tuning_seconds in tuning:
+        lines += [f'`--tear-penalty {penalty}` ({tuning_seconds:.0f} s):', '', *fenced(tuning_out), '']
     lines += [
-        'Adaptive minus uniform, and the mean number of planes, per share and count:',
+        'Adaptive minus uniform, and the mean number of planes, per penalty and count:',
         '',
-        '| --min-plane-share | count | planes | SSIM difference | PSNR difference (dB) |',
-        '|---|---:|---:|---:|---:|',
-    ]
-    for share, tuning_out, _ in tuning:
-        rows = slicing_rows(tuning_out)
-        for count in sorted({c for c, _ in rows}):
-            a, u = rows[(count, 'adaptive')], rows[(count, 'uniform')]
-            lines.append(f'| {share} | {count} | {a[0]:.2f} | {a[1] - u[1]:+.4f} | {a[2] - u[2]:+.3f} |')
-    lines += [
+        *adaptive_minus_uniform(tuning, '--tear-penalty'),
         '',
-        'The guard trades planes for placement: the larger the share, the fewer planes adaptive',
-        'makes (and uniform with it), so the views of both get worse while adaptive closes in on',
-        'uniform. 0.5 is the default: it keeps most of the planes.',
+        f'The default is {TUNING_TEAR_PENALTIES[0]}, no penalty: {penalty_effect(tuning)}.',
         '',
         '## The same with exact depth',
         '',
