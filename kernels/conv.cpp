@@ -4,19 +4,16 @@
 #include <array>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "engine/cpu_caches.h"
 #include "engine/tensor.h"
 
 namespace ampi {
 namespace {
 
-// Depthwise rows carry a fixed array of input-row pointers; taller kernels (none in the
-// networks) take the general path.
-constexpr int kMaxDepthwiseKernelH = 16;
 // General path: output pixels per im2col tile, in gemm tiles. Eight tiles amortise the
 // per-tile loop while the scratch (tile pixels x kernel_h*kernel_w*in_c/groups floats:
 // 48 x 1152 floats = 216 KiB for a 3x3 conv over 128 channels on AVX2) stays in L2.
@@ -44,35 +41,13 @@ constexpr size_t kStreamOutputCaches = 1;
 // When the system does not say (no sysfs cache description, e.g. under qemu).
 constexpr size_t kDefaultLastLevelCacheBytes = size_t{32} << 20;
 
-// The size of CPU 0's highest cache level, from sysfs ("32768K"). Not sysconf: glibc
-// reads it from cpuid, which under KVM here says 384 MiB for a 32 MiB L3.
-size_t last_level_cache_bytes() {
-  static const size_t bytes = [] {
-    int best_level = 0;
-    size_t best_bytes = kDefaultLastLevelCacheBytes;
-    for (int index = 0; index < 8; ++index) {
-      const std::string dir = "/sys/devices/system/cpu/cpu0/cache/index" + std::to_string(index) + "/";
-      std::ifstream level_file(dir + "level"), size_file(dir + "size");
-      int level = 0;
-      size_t size = 0;
-      std::string unit;
-      if (!(level_file >> level) || !(size_file >> size)) continue;
-      size_file >> unit;
-      const size_t scale = unit == "K" ? 1024 : unit == "M" ? 1024 * 1024 : 1;
-      if (level > best_level && size > 0) best_level = level, best_bytes = size * scale;
-    }
-    return best_bytes;
-  }();
-  return bytes;
-}
-
 // Whether an output of `floats` at `out` with c channels (c floats apart, pixel after
 // pixel) can and should be stored with streaming stores (DepthwiseRowArgs::stream_out,
 // GemmArgs::stream_c).
 bool stream_output(const float* out, int64_t floats, int c) {
   const bool whole_lines = reinterpret_cast<uintptr_t>(out) % 64 == 0 && c % 16 == 0;
   const size_t bytes = static_cast<size_t>(floats) * sizeof(float);
-  return whole_lines && bytes > kStreamOutputCaches * last_level_cache_bytes();
+  return whole_lines && bytes > kStreamOutputCaches * cache_bytes(0, kDefaultLastLevelCacheBytes);
 }
 
 [[noreturn]] void fail(const std::string& what) { throw std::runtime_error("conv: " + what); }
@@ -99,7 +74,7 @@ Conv2d::Path choose_path(const ConvParams& p) {
   if (p.groups == 1 && p.kernel_h == 1 && p.kernel_w == 1 && p.stride_h == 1 && p.stride_w == 1 &&
       no_padding)
     return Conv2d::Path::Pointwise;
-  if (p.groups == p.in_c && p.in_c == p.out_c && p.kernel_h <= kMaxDepthwiseKernelH)
+  if (p.groups == p.in_c && p.in_c == p.out_c && p.kernel_h <= kMaxDepthwiseKernelH)  // taller: general path
     return Conv2d::Path::Depthwise;
   if (p.groups == 1 && p.out_c <= kTapsMaxOutputs && p.stride_h == 1 && p.stride_w == 1 &&
       p.kernel_h * p.kernel_w > 1)

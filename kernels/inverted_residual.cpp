@@ -6,19 +6,30 @@
 #include <string>
 #include <vector>
 
+#include "engine/cpu_caches.h"
+
 namespace ampi {
 namespace {
 
-// What one task keeps in cache: the ring of expanded rows and the depthwise row. Half of a
-// 512 KiB L2, so the input rows and the packed weights fit beside it.
-constexpr int64_t kTileCacheBytes = 256 * 1024;
-// Tiles per thread: enough that uneven tiles (the last band and strip are shorter) even
-// out between threads.
-constexpr int kTilesPerThread = 8;
+// What one task keeps in cache: the ring of expanded rows and the depthwise row, in half
+// of the core's L2 (so the input rows and the packed weights fit beside it), at least
+// kMinTileCacheBytes. Larger tiles mean wider strips: fewer halo columns expanded twice
+// and fewer depthwise border blocks; on a core with a 2 MiB L2, a 1 MiB budget ran the
+// lite network's widest block faster than 256 KiB did.
+constexpr int64_t kMinTileCacheBytes = 256 * 1024;
+constexpr size_t kDefaultL2Bytes = 512 * 1024;  // when the system does not say
+
+int64_t tile_cache_bytes() {
+  return std::max<int64_t>(kMinTileCacheBytes, int64_t(cache_bytes(2, kDefaultL2Bytes) / 2));
+}
+// Tiles per thread: two, so a thread that starts late or runs slower is partly made up
+// for by the other, but no more: every tile expands the rows and columns at its seams
+// again, which on the small maps of the deep levels costs more than balance gains (lite's
+// 160->320->80 block at 64x48 on 2 threads: 2.6-2.8 ms with 8 tiles per thread, 1.9 ms
+// with 2).
+constexpr int kTilesPerThread = 2;
 // Bands at least this many times as tall as the rows their seams compute twice.
 constexpr int kMinBandSeams = 8;
-// Depthwise kernels taller than this take the separate steps (Conv2d::run handles them).
-constexpr int kMaxKernelH = 16;
 
 [[noreturn]] void reject(const std::string& why) {
   throw std::invalid_argument("InvertedResidual: " + why);
@@ -31,7 +42,7 @@ void check_chain(const std::optional<Conv2d>& expand, const Conv2d& dw, const Co
   if (d.pad_top + d.pad_bottom != (d.kernel_h - 1) * d.dilation_h ||
       d.pad_left + d.pad_right != (d.kernel_w - 1) * d.dilation_w)
     reject("the depthwise padding does not keep the size");
-  if (d.kernel_h > kMaxKernelH) reject("the depthwise kernel is taller than 16");
+  if (d.kernel_h > kMaxDepthwiseKernelH) reject("the depthwise kernel is taller than 16");
   if (project.path() != Conv2d::Path::Pointwise) reject("the projection is not pointwise");
   if (project.params().in_c != d.in_c) reject("the projection does not read the depthwise output");
   if (&project.table() != &dw.table()) reject("the convolutions are packed for different tables");
@@ -76,13 +87,17 @@ void InvertedResidual::run(const float* in, int h, int w, float* out, const floa
   const ConvParams& d = dw_.params();
   const int span = (d.kernel_h - 1) * d.dilation_h + 1;  // input rows one output row reads
   const int halo = (d.kernel_w - 1) * d.dilation_w;      // extra input columns of a strip
-  // Strips as wide as the cache allows for the ring (span rows) plus the depthwise row.
+  // Strips as wide as the cache allows for the ring (span rows) plus the depthwise row,
+  // and bands; more strips where the map is too short for enough bands (the small maps
+  // of the deep levels), so every thread still gets its tiles.
   const int64_t pixel_bytes = int64_t(expanded_) * sizeof(float);
-  const int fit = int(std::max<int64_t>(8, kTileCacheBytes / ((span + 1) * pixel_bytes) - halo));
-  const int strips = (w + fit - 1) / fit;
+  const int fit = int(std::max<int64_t>(8, tile_cache_bytes() / ((span + 1) * pixel_bytes) - halo));
+  const int wanted_tiles = kTilesPerThread * pool.size();
+  const int max_bands = std::clamp(h / std::max(1, kMinBandSeams * (span - 1)), 1, h);
+  const int max_strips = std::clamp(w / std::max(1, kMinBandSeams * halo), 1, w);
+  const int strips = std::max((w + fit - 1) / fit, std::min(max_strips, (wanted_tiles + max_bands - 1) / max_bands));
   const int strip_w = (w + strips - 1) / strips;
-  const int wanted_bands = (kTilesPerThread * pool.size() + strips - 1) / strips;
-  const int bands = std::clamp(std::min(wanted_bands, h / std::max(1, kMinBandSeams * (span - 1))), 1, h);
+  const int bands = std::min(max_bands, (wanted_tiles + strips - 1) / strips);
   const int band_h = (h + bands - 1) / bands;
   const int ring_w = std::min(w, strip_w + halo);
   pool.parallel_for(int64_t(bands) * strips, 1, [&](int64_t first, int64_t last) {
@@ -117,7 +132,7 @@ void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, fl
     return expand_ ? ring_slot(r) : in + (int64_t(r) * w + cx0) * in_c_;
   };
   int next_row = std::max(0, t.y0 - d.pad_top);  // the first row not yet expanded
-  std::array<const float*, kMaxKernelH> rows;
+  std::array<const float*, kMaxDepthwiseKernelH> rows;
   a.in_rows = rows.data();
   for (int y = t.y0; y < t.y1; ++y) {
     const int top = y - d.pad_top;

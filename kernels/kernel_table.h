@@ -42,6 +42,9 @@ struct GemmArgs {
   int64_t prefetch_floats = 0;
 };
 
+// The tallest depthwise kernel the row kernels take (in_rows has kernel_h entries).
+constexpr int kMaxDepthwiseKernelH = 16;
+
 // One output row of a depthwise convolution (channel multiplier 1), NHWC:
 // out[x][c] = act(bias[c] + sum_{ky,kx} w[ky][kx][c] * row_ky[x*stride_w - pad_left +
 // kx*dilation_w][c]) (+ residual[x][c]); taps outside the row or on a padding row count 0.
