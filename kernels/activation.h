@@ -18,9 +18,9 @@ const char* activation_name(Activation a);
 // "hardsigmoid", "sigmoid", "leakyrelu", "elu", "tanh"); throws std::invalid_argument.
 Activation parse_activation(const char* name);
 
-// The vector activations multiply by 1/6 where this reference divides by 6 (within an
-// ulp): a vector divide costs several FMAs' time, and hardswish ends every GEMM tile and
-// depthwise block of the depth network.
+// The vector activations compute the gate as clamp(x * (1/6) + 1/2, 0, 1), one FMA, where
+// this reference divides x + 3 by 6 (within a few ulp): a vector divide costs several FMAs'
+// time, and hardswish ends every GEMM tile and depthwise block of the depth network.
 constexpr float kOneSixth = 1.0f / 6.0f;
 
 inline float activate(float x, ActivationSpec a) {

@@ -51,8 +51,9 @@ inline float32x4_t activate(float32x4_t x, ActivationSpec a) {
     case Activation::ReLU6: return vminq_f32(vmaxq_f32(x, zero), vdupq_n_f32(6.0f));
     case Activation::HardSigmoid:
     case Activation::HardSwish: {
-      float32x4_t g = vaddq_f32(x, vdupq_n_f32(3.0f));
-      g = vmulq_f32(vminq_f32(vmaxq_f32(g, zero), vdupq_n_f32(6.0f)), vdupq_n_f32(kOneSixth));  // no divide (kOneSixth)
+      // clamp(x/6 + 1/2, 0, 1): one FMA where (x + 3) / 6 takes an add and a multiply
+      float32x4_t g = vfmaq_f32(vdupq_n_f32(0.5f), x, vdupq_n_f32(kOneSixth));
+      g = vminq_f32(vmaxq_f32(g, zero), vdupq_n_f32(1.0f));
       return a.kind == Activation::HardSwish ? vmulq_f32(x, g) : g;
     }
     case Activation::Sigmoid: return sigmoid(x);

@@ -54,9 +54,9 @@ inline __m256 activate(__m256 x, ActivationSpec a) {
     case Activation::ReLU6: return _mm256_min_ps(_mm256_max_ps(x, zero), _mm256_set1_ps(6.0f));
     case Activation::HardSigmoid:
     case Activation::HardSwish: {
-      __m256 g = _mm256_add_ps(x, _mm256_set1_ps(3.0f));
-      g = _mm256_min_ps(_mm256_max_ps(g, zero), _mm256_set1_ps(6.0f));
-      g = _mm256_mul_ps(g, _mm256_set1_ps(kOneSixth));  // no divide (kOneSixth)
+      // clamp(x/6 + 1/2, 0, 1): one FMA where (x + 3) / 6 takes an add and a multiply
+      __m256 g = _mm256_fmadd_ps(x, _mm256_set1_ps(kOneSixth), _mm256_set1_ps(0.5f));
+      g = _mm256_min_ps(_mm256_max_ps(g, zero), _mm256_set1_ps(1.0f));
       return a.kind == Activation::HardSwish ? _mm256_mul_ps(x, g) : g;
     }
     case Activation::Sigmoid: return sigmoid(x);

@@ -50,9 +50,9 @@ inline __m512 activate(__m512 x, ActivationSpec a) {
     case Activation::ReLU6: return _mm512_min_ps(_mm512_max_ps(x, zero), _mm512_set1_ps(6.0f));
     case Activation::HardSigmoid:
     case Activation::HardSwish: {
-      __m512 g = _mm512_add_ps(x, _mm512_set1_ps(3.0f));
-      g = _mm512_min_ps(_mm512_max_ps(g, zero), _mm512_set1_ps(6.0f));
-      g = _mm512_mul_ps(g, _mm512_set1_ps(kOneSixth));  // no divide (kOneSixth)
+      // clamp(x/6 + 1/2, 0, 1): one FMA where (x + 3) / 6 takes an add and a multiply
+      __m512 g = _mm512_fmadd_ps(x, _mm512_set1_ps(kOneSixth), _mm512_set1_ps(0.5f));
+      g = _mm512_min_ps(_mm512_max_ps(g, zero), _mm512_set1_ps(1.0f));
       return a.kind == Activation::HardSwish ? _mm512_mul_ps(x, g) : g;
     }
     case Activation::Sigmoid: return sigmoid(x);
