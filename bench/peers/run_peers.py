@@ -164,15 +164,39 @@ def relative_difference(peer: np.ndarray, ampi: np.ndarray) -> float:
     return float(np.abs(peer[:h, :w].astype(np.float64) - ampi).max() / span)
 
 
+def rounds_runs(runs: int, rounds: int) -> int:
+    """Timed runs per engine process when `runs` are spread over `rounds` rounds."""
+    return -(-runs // rounds)
+
+
+def pool_timings(pooled: dict, results: dict):
+    """Adds one round's results of an engine to its earlier rounds': the timings of each
+    thread count joined, the busiest round's foreign load kept."""
+    for threads, record in results.items():
+        if threads not in pooled:
+            pooled[threads] = dict(record, ms=list(record["ms"]))
+            continue
+        pooled[threads]["ms"] += record["ms"]
+        loads = [f for f in (pooled[threads]["foreign_cores"], record["foreign_cores"]) if f is not None]
+        pooled[threads]["foreign_cores"] = max(loads) if loads else None
+
+
 def measure_case(args, weights: Path, size, runs: int, folder: Path, multiple: int) -> dict:
+    """One network and size: --rounds rounds, each running every engine once in turn, so
+    a slow spell of a shared machine falls on every engine rather than on whichever ran
+    then; each engine's timings are pooled over the rounds. The outputs of the last round
+    are compared."""
     hwc, nchw, padded = make_inputs(args.photo, size, multiple, folder)
     onnx = export_onnx(weights, padded, folder)
     save = folder / f"out_{weights.stem}_{size[0]}x{size[1]}"
-    case = {"model": weights.stem.replace("depth_", ""), "size": size, "padded": padded, "runs": runs,
-            "engines": {}, "diff": {}, "range": {}}
-    for name, cmd in engine_commands(args, weights, onnx, hwc, nchw, runs, save).items():
-        print(f"  {case['model']} {size[0]}x{size[1]}: {name} ...", file=sys.stderr, flush=True)
-        case["engines"][name] = run_engine(name, cmd, args)
+    case = {"model": weights.stem.replace("depth_", ""), "size": size, "padded": padded,
+            "runs": rounds_runs(runs, args.rounds) * args.rounds, "engines": {}, "diff": {}, "range": {}}
+    commands = engine_commands(args, weights, onnx, hwc, nchw, rounds_runs(runs, args.rounds), save)
+    for round_index in range(args.rounds):
+        for name, cmd in commands.items():
+            print(f"  {case['model']} {size[0]}x{size[1]}: {name} (round {round_index + 1} of {args.rounds}) ...",
+                  file=sys.stderr, flush=True)
+            pool_timings(case["engines"].setdefault(name, {}), run_engine(name, cmd, args))
     for t in args.threads:
         ampi = np.load(f"{save}_ampi.t{t}.npy").astype(np.float64)
         case["range"][t] = (float(ampi.min()), float(ampi.max()))
@@ -298,7 +322,8 @@ def quiet_section(cases, args) -> list:
              "(bench/peers/foreign_load.py: busy time of the whole machine in /proc/stat minus the "
              f"engine's own CPU time). Each engine waited up to {args.wait_quiet:g} s for a quiet "
              f"half-second before starting and was re-run (up to {args.retries} times) while this "
-             f"exceeded {args.max_foreign:.2f}; the quietest run is kept. `n/a`: no /proc/stat.", "",
+             f"exceeded {args.max_foreign:.2f}; the quietest run of each round is kept, and the table "
+             "gives the busiest round's. `n/a`: no /proc/stat.", "",
              "| network | size | ampi | ONNX Runtime | OpenCV DNN | PyTorch |", "|---|---|---:|---:|---:|---:|"]
     for case in cases:
         w, h = case["size"]
@@ -318,7 +343,7 @@ def wrap_note(args) -> str:
 
 
 # The settings a report states, kept with the raw timings so --report-from can re-make it.
-REPORT_SETTINGS = ("models", "sizes", "threads", "warmup", "wrap", "max_foreign", "retries", "wait_quiet", "commit")
+REPORT_SETTINGS = ("models", "sizes", "threads", "warmup", "rounds", "wrap", "max_foreign", "retries", "wait_quiet", "commit")
 
 
 def save_raw(args, cases, seconds: float):
@@ -360,7 +385,7 @@ def write_results(args, cases, seconds: float):
         "Made by `bash bench/peers/run.sh` (bench/peers/README.md) in one run of "
         f"{seconds / 60:.1f} minutes (wall clock, waits included) at commit {args.commit}, with "
         f"`--models {args.models} --sizes {args.sizes} --threads {','.join(map(str, args.threads))} "
-        f"--warmup {args.warmup}`{wrap_note(args)}; rerun it to refresh this file.", "",
+        f"--warmup {args.warmup} --rounds {args.rounds}`{wrap_note(args)}; rerun it to refresh this file.", "",
         f"- Machine: {cpu_model()}, {os.cpu_count()} cores; ampi's kernels: {v['isa']}.",
         "- Engines, all on the CPU, the same thread count each (1, then 2):",
         "  ampi (`ampi bench network`, DepthNet::run on its own kernels);",
@@ -375,7 +400,9 @@ def write_results(args, cases, seconds: float):
         f"- Input: `{args.photo.relative_to(REPO) if args.photo.is_relative_to(REPO) else args.photo}` resized "
         "to each size, RGB in [0, 1], the same pixels for every engine; each engine times the network "
         "call alone (input normalisation included, loading excluded), wall clock, after "
-        f"{args.warmup} untimed run(s); medians of the runs given per row.{pad_note}",
+        f"{args.warmup} untimed run(s) per process; the engines take turns in {args.rounds} round(s) per "
+        "row (a process per engine and round, the timed runs split between the rounds), so a slow spell of "
+        f"the machine falls on all of them; medians of all runs given per row.{pad_note}",
         "- Ratios below 1 mean ampi is faster.", "",
     ]
     lines += (targets_section(cases, args) + latency_section(cases, args) + difference_section(cases, args.threads)
@@ -398,6 +425,8 @@ def main(argv=None):
                    help="WxH:RUNS,... (timed runs per thread count)")
     p.add_argument("--threads", default="1,2")
     p.add_argument("--warmup", type=int, default=1)
+    p.add_argument("--rounds", type=int, default=3,
+                   help="rounds of all engines in turn per case; the timed runs are split between them")
     p.add_argument("--photo", type=Path, default=REPO / "examples" / "forest_path.jpg")
     p.add_argument("--results", default=str(REPO / "bench" / "RESULTS.md"))
     p.add_argument("--smoke", action="store_true", help="64x64 lite, 1 run, check differences only")
@@ -414,7 +443,9 @@ def main(argv=None):
                         "(waits for a lock and pauses background jobs while the engine runs)")
     args = p.parse_args(argv)
     if args.smoke:
-        args.models, args.sizes, args.warmup, args.retries, args.wait_quiet = "lite", "64x64:1", 0, 0, 0
+        args.models, args.sizes, args.warmup, args.retries, args.wait_quiet, args.rounds = "lite", "64x64:1", 0, 0, 0, 1
+    if args.rounds < 1:
+        fail("--rounds must be at least 1")
     args.threads = [int(t) for t in args.threads.split(",")]
     args.work.mkdir(parents=True, exist_ok=True)
     if not args.photo.is_file():
