@@ -71,6 +71,7 @@ void pointwise_rows(const Conv2d& conv, const float* a, int64_t pixels, float* c
 
 struct InvertedResidual::Scratch {
   std::vector<float> ring, dw_row;
+  std::vector<float> input_row, residual_row;  // concatenated input pixels (run_concat)
 };
 
 InvertedResidual::InvertedResidual(std::optional<Conv2d> expand, Conv2d dw, Conv2d project)
@@ -83,6 +84,21 @@ InvertedResidual::InvertedResidual(std::optional<Conv2d> expand, Conv2d dw, Conv
 
 void InvertedResidual::run(const float* in, int h, int w, float* out, const float* residual,
                            ThreadPool& pool) const {
+  run_input({in, in_c_}, h, w, out, residual, false, pool);
+}
+
+void InvertedResidual::run_concat(const float* first, int first_c, const float* second, int second_c, int h,
+                                  int w, float* out, bool add_input, ThreadPool& pool) const {
+  if (first_c <= 0 || second_c <= 0 || first_c + second_c != in_c_)
+    reject("run_concat: " + std::to_string(first_c) + " + " + std::to_string(second_c) +
+           " channels are not the block's " + std::to_string(in_c_));
+  if (!expand_) reject("run_concat needs an expansion");
+  if (add_input && in_c_ != out_c_) reject("run_concat: the input cannot be added to an output of other width");
+  run_input({first, first_c, second, second_c}, h, w, out, nullptr, add_input, pool);
+}
+
+void InvertedResidual::run_input(const Input& in, int h, int w, float* out, const float* residual,
+                                 bool add_input, ThreadPool& pool) const {
   if (h <= 0 || w <= 0) throw std::invalid_argument("InvertedResidual: empty input");
   const ConvParams& d = dw_.params();
   const int span = (d.kernel_h - 1) * d.dilation_h + 1;  // input rows one output row reads
@@ -106,13 +122,13 @@ void InvertedResidual::run(const float* in, int h, int w, float* out, const floa
       const int band = int(i / strips), strip = int(i % strips);
       const Tile t{band * band_h, std::min(h, (band + 1) * band_h), strip * strip_w,
                    std::min(w, (strip + 1) * strip_w)};
-      if (t.y0 < t.y1 && t.x0 < t.x1) run_tile(t, in, h, w, out, residual, ring_w, scratch);
+      if (t.y0 < t.y1 && t.x0 < t.x1) run_tile(t, in, h, w, out, residual, add_input, ring_w, scratch);
     }
   });
 }
 
-void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, float* out,
-                                const float* residual, int ring_w, Scratch& s) const {
+void InvertedResidual::run_tile(const Tile& t, const Input& in, int h, int w, float* out,
+                                const float* residual, bool add_input, int ring_w, Scratch& s) const {
   const ConvParams& d = dw_.params();
   const int span = (d.kernel_h - 1) * d.dilation_h + 1;
   // The input columns the strip reads, and the depthwise arguments for a row of them: the
@@ -128,8 +144,17 @@ void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, fl
   // Input row r's columns [cx0, cx1) after the expansion: its ring slot, or the input
   // itself when there is no expansion.
   const auto ring_slot = [&](int r) { return s.ring.data() + (r % span) * ring_row; };
-  const auto expanded_row = [&](int r) -> const float* {
-    return expand_ ? ring_slot(r) : in + (int64_t(r) * w + cx0) * in_c_;
+  // `count` input pixels from pixel `first` on: the map itself, or a concatenated input's
+  // pixels gathered into `buffer`.
+  const auto input_pixels = [&](int64_t first, int count, std::vector<float>& buffer) -> const float* {
+    if (!in.second) return in.first + first * in_c_;
+    if (buffer.size() < size_t(count) * in_c_) buffer.resize(size_t(count) * in_c_);
+    dw_.table().concat_channels(in.first + first * in.first_c, in.first_c, in.second + first * in.second_c,
+                                in.second_c, count, buffer.data());
+    return buffer.data();
+  };
+  const auto expanded_row = [&](int r) -> const float* {  // a concatenated input has an expansion
+    return expand_ ? ring_slot(r) : in.first + (int64_t(r) * w + cx0) * in_c_;
   };
   int next_row = std::max(0, t.y0 - d.pad_top);  // the first row not yet expanded
   std::array<const float*, kMaxDepthwiseKernelH> rows;
@@ -137,7 +162,8 @@ void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, fl
   for (int y = t.y0; y < t.y1; ++y) {
     const int top = y - d.pad_top;
     for (const int last = std::min(h, top + span); expand_ && next_row < last; ++next_row)
-      pointwise_rows(*expand_, in + (int64_t(next_row) * w + cx0) * in_c_, cols, ring_slot(next_row), nullptr);
+      pointwise_rows(*expand_, input_pixels(int64_t(next_row) * w + cx0, cols, s.input_row), cols,
+                     ring_slot(next_row), nullptr);
     for (int ky = 0; ky < d.kernel_h; ++ky) {
       const int iy = top + ky * d.dilation_h;
       rows[ky] = iy >= 0 && iy < h ? expanded_row(iy) : nullptr;
@@ -145,8 +171,10 @@ void InvertedResidual::run_tile(const Tile& t, const float* in, int h, int w, fl
     a.out = s.dw_row.data();
     dw_.table().depthwise_row(a);
     const int64_t first = int64_t(y) * w + t.x0;
-    pointwise_rows(project_, s.dw_row.data(), out_w, out + first * out_c_,
-                   residual ? residual + first * out_c_ : nullptr);
+    const float* row_residual = add_input  ? input_pixels(first, out_w, s.residual_row)
+                                : residual ? residual + first * out_c_
+                                           : nullptr;
+    pointwise_rows(project_, s.dw_row.data(), out_w, out + first * out_c_, row_residual);
   }
 }
 

@@ -34,13 +34,31 @@ class InvertedResidual {
   void run(const float* in, int h, int w, float* out, const float* residual,
            ThreadPool& pool = default_pool()) const;
 
+  // The same on the channel concatenation of two maps (a decoder's upsampled map and its
+  // skip connection): pixel p's input is first[p] (first_c floats) then second[p]
+  // (second_c floats), first_c + second_c = in_c, without the concatenated map ever
+  // being written: each tile concatenates the rows it expands, in cache. add_input: the
+  // residual is the (concatenated) input itself (in_c == out_c). Needs an expansion.
+  // Bitwise run() on the concatenated map.
+  void run_concat(const float* first, int first_c, const float* second, int second_c, int h, int w,
+                  float* out, bool add_input, ThreadPool& pool = default_pool()) const;
+
  private:
   struct Tile {
     int y0, y1, x0, x1;
   };
-  struct Scratch;  // one thread's ring of expanded rows and depthwise row
-  void run_tile(const Tile& t, const float* in, int h, int w, float* out, const float* residual,
-                int ring_w, Scratch& s) const;
+  // The block's input: one map (second == nullptr), or two concatenated by channel.
+  struct Input {
+    const float* first;
+    int first_c;
+    const float* second = nullptr;
+    int second_c = 0;
+  };
+  struct Scratch;  // one thread's ring of expanded rows, depthwise row and input rows
+  void run_input(const Input& in, int h, int w, float* out, const float* residual, bool add_input,
+                 ThreadPool& pool) const;
+  void run_tile(const Tile& t, const Input& in, int h, int w, float* out, const float* residual,
+                bool add_input, int ring_w, Scratch& s) const;
 
   std::optional<Conv2d> expand_;
   Conv2d dw_, project_;

@@ -243,6 +243,8 @@ struct DepthNet::Impl {
   std::unique_ptr<Plan> build_plan(int h, int w) const;
   int add_stage(Plan& p, const Stage& stage, int x, int h, int w) const;
   int add_block(Plan& p, const Block& b, int x, int h, int w) const;
+  // Block b on the channel concatenation of the maps up and skip (a decoder's first block).
+  int add_concat_block(Plan& p, const Block& b, int up, int skip, int h, int w) const;
 };
 
 // Loads and checks everything the metadata promises before any weight is packed.
@@ -340,6 +342,29 @@ int DepthNet::Impl::add_block(Plan& p, const Block& b, int x, int h, int w) cons
   return y;
 }
 
+int DepthNet::Impl::add_concat_block(Plan& p, const Block& b, int up, int skip, int h, int w) const {
+  const int up_c = p.value(up).c, skip_c = p.value(skip).c;
+  if (!b.fused) {  // the concatenated map, then the block on it
+    const int cat = p.produce(h, w, up_c + skip_c);
+    p.consume(up);
+    p.consume(skip);
+    const int64_t pixels = int64_t(h) * w;
+    p.push([this, up, skip, cat, up_c, skip_c, pixels](Plan& pl, ThreadPool& pool) {
+      concat_channels(pl.data(up), up_c, pl.data(skip), skip_c, pixels, pl.data(cat), pool, *table);
+    });
+    return add_block(p, b, cat, h, w);
+  }
+  // A fused block concatenates the rows it expands itself: the concatenated map (the
+  // widest map of the level, read back at once) is never written.
+  const int y = p.produce(h, w, b.spec.out_c);
+  p.consume(up);
+  p.consume(skip);
+  p.push([&b, up, skip, y, up_c, skip_c, h, w](Plan& pl, ThreadPool& pool) {
+    b.fused->run_concat(pl.data(up), up_c, pl.data(skip), skip_c, h, w, pl.data(y), b.residual, pool);
+  });
+  return y;
+}
+
 int DepthNet::Impl::add_stage(Plan& p, const Stage& stage, int x, int h, int w) const {
   for (const Block& b : stage) x = add_block(p, b, x, h, w);
   return x;
@@ -370,21 +395,16 @@ std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
     skips.push_back(x);
   }
   for (int l = levels - 1; l >= 1; --l) {
-    const int skip = skips[l - 1], skip_c = p->value(skip).c, up_c = c / 4;
+    const int skip = skips[l - 1], up_c = c / 4;
     const int u = p->produce(2 * lh, 2 * lw, up_c);
     p->consume(x);
     p->push([&k, x, u, lh, lw, up_c](Plan& pl, ThreadPool& pool) { haar_idwt(pl.data(x), lh, lw, up_c, pl.data(u), pool, k); });
     lh *= 2;
     lw *= 2;
-    const int cat = p->produce(lh, lw, up_c + skip_c);
-    p->consume(u);
-    p->consume(skip);
-    const int64_t pixels = int64_t(lh) * lw;
-    p->push([&k, u, skip, cat, up_c, skip_c, pixels](Plan& pl, ThreadPool& pool) {
-      concat_channels(pl.data(u), up_c, pl.data(skip), skip_c, pixels, pl.data(cat), pool, k);
-    });
-    x = add_stage(*p, decoder[l - 1], cat, lh, lw);
-    c = out_channels(decoder[l - 1]);
+    const Stage& stage = decoder[l - 1];
+    x = add_concat_block(*p, stage.front(), u, skip, lh, lw);
+    for (size_t i = 1; i < stage.size(); ++i) x = add_block(*p, stage[i], x, lh, lw);
+    c = out_channels(stage);
   }
   const int coeffs = p->produce(lh, lw, 4);
   p->consume(x);

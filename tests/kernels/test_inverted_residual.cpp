@@ -162,3 +162,50 @@ TEST_CASE("fused inverted residual rejects convolutions that do not chain") {
                   std::invalid_argument);
   CHECK_THROWS_AS(InvertedResidual(expand, project, project), std::invalid_argument);
 }
+
+TEST_CASE("fused inverted residual on two concatenated maps equals it on their concatenation") {
+  for (const int first_c : sweep<int>({1, 8, 16}, {8}))
+    for (const int second_c : sweep<int>({7, 16}, {16}))
+      for (const bool add_input : {false, true}) {
+        const int in_c = first_c + second_c, h = 9, w = 300;  // several strips and bands
+        const BlockCase b{in_c, 4 * in_c, add_input ? in_c : 24, 3, 1, 1, 1, h, w, add_input,
+                          uint32_t(500 + 10 * first_c + second_c)};
+        for (Isa isa : runnable_isas())
+          for (ThreadPool* pool : thread_pools()) {
+            const KernelTable& k = kernels_for(isa);
+            const Layers l = make_layers(b, k);
+            const InvertedResidual fused(l.expand, l.dw, l.project);
+            const size_t pixels = size_t(h) * w;
+            const auto first = random_floats(pixels * first_c, b.seed + 100);
+            const auto second = random_floats(pixels * second_c, b.seed + 101);
+            std::vector<float> joined(pixels * in_c), expected(pixels * b.out_c);
+            k.concat_channels(first.data(), first_c, second.data(), second_c, int64_t(pixels), joined.data());
+            fused.run(joined.data(), h, w, expected.data(), add_input ? joined.data() : nullptr, *pool);
+            GuardedOutput out(pixels * b.out_c);
+            fused.run_concat(first.data(), first_c, second.data(), second_c, h, w, out.data(), add_input, *pool);
+            INFO(describe(b) << ", split " << first_c << " + " << second_c << ", isa " << isa_name(isa)
+                             << ", threads " << pool->size());
+            REQUIRE(out.guard_intact());
+            REQUIRE(std::equal(expected.begin(), expected.end(), out.data(),
+                               [](float x, float y) { return std::memcmp(&x, &y, sizeof x) == 0; }));
+          }
+      }
+}
+
+TEST_CASE("fused inverted residual rejects a concatenation that does not fit it") {
+  const BlockCase b{24, 96, 24, 3, 1, 1, 1, 4, 4, true, 600};
+  const Layers l = make_layers(b, kernels());
+  const InvertedResidual fused(l.expand, l.dw, l.project);
+  const std::vector<float> in(16 * 24, 0.5f);
+  std::vector<float> out(16 * 24);
+  CHECK_THROWS_AS(fused.run_concat(in.data(), 8, in.data(), 8, 4, 4, out.data(), false), std::invalid_argument);
+  CHECK_THROWS_AS(fused.run_concat(in.data(), 0, in.data(), 24, 4, 4, out.data(), false), std::invalid_argument);
+  const BlockCase plain{16, 16, 16, 3, 1, 1, 1, 4, 4, true, 601};  // no expansion
+  const Layers p = make_layers(plain, kernels());
+  const InvertedResidual unexpanded(p.expand, p.dw, p.project);
+  CHECK_THROWS_AS(unexpanded.run_concat(in.data(), 8, in.data(), 8, 4, 4, out.data(), true), std::invalid_argument);
+  const BlockCase widening{24, 96, 32, 3, 1, 1, 1, 4, 4, false, 602};
+  const Layers wl = make_layers(widening, kernels());
+  const InvertedResidual widens(wl.expand, wl.dw, wl.project);
+  CHECK_THROWS_AS(widens.run_concat(in.data(), 8, in.data(), 16, 4, 4, out.data(), true), std::invalid_argument);
+}
