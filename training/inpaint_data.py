@@ -50,9 +50,12 @@ MAX_SIDE = 768  # photos are kept at most this large (the long side), like a 102
 ERODE_RANGE = (8, 40)  # training erosion iterations; the inference margin is 40 px
 MIN_REMOVED, MIN_KNOWN = 0.02, 0.25  # fractions of a crop a sample needs
 
-# transition selection, as slicing/adaptive.h
+# transition selection, as slicing/adaptive.h's paper slicer with its plane guard at 0.5
+# (`ampi slice --slicer paper --min-plane-share 0.5`): the slicing the bundled inpainting
+# network trained on. ampi's default slicer now keeps the paper's plane count but places
+# the cuts by dynamic programming (slicing/optimal_cuts.h), with no guard.
 SLICE_EPS, SLICE_XI, SLICE_THRESHOLD, SLICE_MAX_PLANES = 0.001, 8, 0.1, 8
-SLICE_MIN_PLANE_SHARE = 0.5  # slicing/adaptive.h min_plane_share: each plane > 0.5 / 8 of h
+SLICE_MIN_PLANE_SHARE = 0.5  # each plane > 0.5 / 8 of h
 EDGE_GRADIENT, EDGE_BAND = 6.0, 7  # levels per pixel that make an edge; band width
 
 
@@ -143,8 +146,9 @@ def slicing_histogram(levels: np.ndarray) -> np.ndarray:
 
 def select_transitions(h: np.ndarray) -> list:
     """The paper's greedy choice on t = laplacian(h) / max(eps, h), with the C++ slicer's
-    guard (slicing/adaptive.h select_transitions): a candidate that would leave a plane
-    with min_plane_share / max_planes of h or less on either side is dropped."""
+    guard (slicing/adaptive.h select_transitions) at SLICE_MIN_PLANE_SHARE: a candidate
+    that would leave a plane with that share / max_planes of h or less on either side is
+    dropped."""
     lap = np.zeros_like(h)
     lap[1:-1] = h[:-2] - 2 * h[1:-1] + h[2:]
     t = lap / np.maximum(SLICE_EPS, h)
