@@ -9,9 +9,8 @@
 //   A block's accumulators, the current kernel row's weights and one input column fit in
 //   the register file, and kBlock independent FMA chains cover the FMA latency. The
 //   interior blocks run channel vector by channel vector along the row, so neighbouring
-//   blocks find the columns they share in L1 (3x3 s1 over 16 channels, a row in L1, on
-//   AVX-512: 35% -> 52% of the FMA peak, one-off harness), the few border blocks pixel
-//   block by pixel block.
+//   blocks find the columns they share (and the weights) in L1; the few border blocks
+//   go pixel block by pixel block.
 // - The kernel height is a compile-time constant too (square kernels), and the row's
 //   arguments are copied to locals: the vector stores may alias anything, so through a
 //   reference every store made the compiler reload the output and row pointers.

@@ -24,9 +24,9 @@ int64_t tile_cache_bytes() {
 }
 // Tiles per thread: two, so a thread that starts late or runs slower is partly made up
 // for by the other, but no more: every tile expands the rows and columns at its seams
-// again, which on the small maps of the deep levels costs more than balance gains (lite's
-// 160->320->80 block at 64x48 on 2 threads: 2.6-2.8 ms with 8 tiles per thread, 1.9 ms
-// with 2).
+// again, which on the small maps of the deep levels cost more than the balance gained
+// (lite's 160->320->80 block at 64x48 on 2 threads ran about a third faster with 2 tiles
+// per thread than with 8).
 constexpr int kTilesPerThread = 2;
 // Bands at least this many times as tall as the rows their seams compute twice.
 constexpr int kMinBandSeams = 8;
@@ -141,9 +141,6 @@ void InvertedResidual::run_tile(const Tile& t, const Input& in, int h, int w, fl
   const int64_t ring_row = int64_t(ring_w) * expanded_;
   if (expand_ && s.ring.size() < size_t(span * ring_row)) s.ring.resize(size_t(span * ring_row));
   if (s.dw_row.size() < size_t(out_w) * expanded_) s.dw_row.resize(size_t(out_w) * expanded_);
-  // Input row r's columns [cx0, cx1) after the expansion: its ring slot, or the input
-  // itself when there is no expansion.
-  const auto ring_slot = [&](int r) { return s.ring.data() + (r % span) * ring_row; };
   // `count` input pixels from pixel `first` on: the map itself, or a concatenated input's
   // pixels gathered into `buffer`.
   const auto input_pixels = [&](int64_t first, int count, std::vector<float>& buffer) -> const float* {
@@ -153,7 +150,10 @@ void InvertedResidual::run_tile(const Tile& t, const Input& in, int h, int w, fl
                                 in.second_c, count, buffer.data());
     return buffer.data();
   };
-  const auto expanded_row = [&](int r) -> const float* {  // a concatenated input has an expansion
+  // Input row r's columns [cx0, cx1) after the expansion: its ring slot, or the input
+  // itself when there is no expansion (a concatenated input always has one).
+  const auto ring_slot = [&](int r) { return s.ring.data() + (r % span) * ring_row; };
+  const auto expanded_row = [&](int r) -> const float* {
     return expand_ ? ring_slot(r) : in.first + (int64_t(r) * w + cx0) * in_c_;
   };
   int next_row = std::max(0, t.y0 - d.pad_top);  // the first row not yet expanded
