@@ -7,11 +7,6 @@
 namespace ampi {
 namespace {
 
-struct CacheLevel {
-  int level = 0;
-  size_t bytes = 0;
-};
-
 // CPU 0's data and unified caches from /sys/devices/system/cpu/cpu0/cache/index*/.
 std::map<int, size_t> read_data_caches() {
   std::map<int, size_t> caches;
