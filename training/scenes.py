@@ -36,6 +36,7 @@ PHOTO_SUFFIXES = {'.jpg', '.jpeg', '.png'}
 DEFAULT_PHOTO_ROOT = Path(__file__).resolve().parents[2] / 'shared' / 'data' / 'photos'
 VALIDATION_SEED_START = 10 ** 9
 VALIDATION_PHOTO_PERIOD = 10      # every tenth photo of a folder (by sorted name) is validation
+ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validation (training/ordinal)
 TEXTURE_MAX_SIDE = 512            # photos are downscaled to this before mip-mapping
 NEAR_CLIP = 0.05                  # metres: nothing nearer than this is rendered
 SHADOW_BIAS = 1e-3                # metres: shadow rays start this far along the light
@@ -67,6 +68,18 @@ def photo_split(path):
     if path.name not in names:
         raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
     return 'val' if names.index(path.name) % VALIDATION_PHOTO_PERIOD == VALIDATION_PHOTO_PERIOD - 1 else 'train'
+
+
+def ordinal_split(path):
+    """'val' for every fifth photo of its folder by sorted name (the synthetic validation
+    photos and as many more), else 'train'. Ordinal validation photos are never trained on:
+    not ranked, and not textures of training scenes either."""
+    path = Path(path)
+    names = _photo_names(str(path.resolve().parent))
+    if path.name not in names:
+        raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
+    period = ORDINAL_VALIDATION_PERIOD
+    return 'val' if names.index(path.name) % period == period - 1 else 'train'
 
 
 def photo_root():
@@ -124,8 +137,12 @@ class TexturePool:
 
 @functools.lru_cache(maxsize=None)
 def texture_pool(split):
-    """The process-wide pool of 'train' or 'val' photos; forked DataLoader workers share it."""
-    return TexturePool(list_photos(split))
+    """The process-wide pool of 'train' or 'val' photos; forked DataLoader workers share it.
+    Training textures leave out the ordinal validation photos as well."""
+    paths = list_photos(split)
+    if split == 'train':
+        paths = [p for p in paths if ordinal_split(p) == 'train']
+    return TexturePool(paths)
 
 
 def pool_for_seed(seed):

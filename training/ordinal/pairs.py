@@ -1,0 +1,251 @@
+#!/usr/bin/env python3
+"""The real-photo ordinal set: point pairs drawn on the photos, marked images to label
+them by eye, and the merged label file.
+
+    /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json
+    /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--only REL...]
+    /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
+
+Pairs come from a fixed seed and each photo's own name, so `sample` always makes the same
+file. Per photo: RANDOM_PAIRS pairs of points uniform over the photo, and EDGE_PAIRS pairs
+straddling a strong image edge (the two points on either side of it, along the gradient),
+so the set also asks about object boundaries. Nothing here looks at any network's output:
+the labels are what a person (or labelling agent) sees in the marked image
+(INSTRUCTIONS.md). Coordinates are pixels of the photo upright (turned by its EXIF orientation, as
+`ampi` reads it; x right, y down).
+"""
+
+import argparse
+import hashlib
+import json
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+from PIL import Image, ImageDraw, ImageFilter, ImageFont, ImageOps
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+import scenes  # noqa: E402  (the photo listing and the split)
+
+HERE = Path(__file__).resolve().parent
+PAIRS_FILE = HERE / 'pairs.json'
+LABELS_DIR = HERE / 'labels'
+ORDINAL_FILE = HERE / 'ordinal.json'
+
+SEED = 2026
+RANDOM_PAIRS = 5
+EDGE_PAIRS = 2
+BORDER = 0.04            # points keep this share of each side away from the border
+MIN_RANDOM_GAP = 0.08    # random pair points at least this share of the diagonal apart
+EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the edge
+EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
+DISPLAY_LONG_SIDE = 1024
+ZOOM = 3
+LABELS = {'A': 1, 'B': -1, '=': 0}   # A nearer, B nearer, too close to call
+PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
+           (0, 230, 230), (255, 140, 0)]
+
+
+def load_upright(path):
+    """The photo as ampi reads it: RGB, turned by its EXIF orientation."""
+    with Image.open(path) as image:
+        return ImageOps.exif_transpose(image).convert('RGB')
+
+
+def photo_rng(rel):
+    digest = hashlib.sha256(f'{SEED}:{rel}'.encode()).digest()
+    return np.random.default_rng(int.from_bytes(digest[:8], 'little'))
+
+
+def random_pairs(rng, w, h, count):
+    lo = np.array([BORDER * w, BORDER * h])
+    hi = np.array([(1 - BORDER) * w, (1 - BORDER) * h])
+    pairs = []
+    while len(pairs) < count:
+        a, b = rng.uniform(lo, hi), rng.uniform(lo, hi)
+        if np.hypot(*(a - b)) >= MIN_RANDOM_GAP * math.hypot(w, h):
+            pairs.append((a, b))
+    return pairs
+
+
+def edge_pairs(rng, gray, count):
+    """Points on both sides of strong edges: gradient of the blurred grey image, an edge
+    pixel drawn among the strongest, the two points EDGE_OFFSET away along the gradient."""
+    h, w = gray.shape
+    gy, gx = np.gradient(gray)
+    magnitude = np.hypot(gx, gy)
+    d = EDGE_OFFSET * max(w, h)
+    margin = np.array([BORDER * w + d, BORDER * h + d])
+    ys, xs = np.nonzero(magnitude >= np.quantile(magnitude, EDGE_QUANTILE))
+    inside = (xs >= margin[0]) & (xs < w - margin[0]) & (ys >= margin[1]) & (ys < h - margin[1])
+    xs, ys = xs[inside], ys[inside]
+    pairs = []
+    for i in rng.permutation(len(xs)):
+        p = np.array([xs[i], ys[i]], float)
+        if any(np.hypot(*(p - q)) < 4 * d for q, _ in pairs):
+            continue   # spread the edge pairs over the photo
+        normal = np.array([gx[ys[i], xs[i]], gy[ys[i], xs[i]]])
+        normal /= np.linalg.norm(normal)
+        pairs.append((p, normal))
+        if len(pairs) == count:
+            break
+    out = []
+    for p, normal in pairs:
+        a, b = p - d * normal, p + d * normal
+        out.append((a, b) if rng.random() < 0.5 else (b, a))
+    return out
+
+
+def sample_photo(path, rel):
+    rng = photo_rng(rel)
+    rgb = load_upright(path)
+    w, h = rgb.size
+    gray = np.asarray(rgb.convert('L').filter(ImageFilter.GaussianBlur(2)), np.float32)
+    pairs = [('random', a, b) for a, b in random_pairs(rng, w, h, RANDOM_PAIRS)]
+    pairs += [('edge', a, b) for a, b in edge_pairs(rng, gray, EDGE_PAIRS)]
+    return {'photo': rel, 'width': w, 'height': h, 'split': scenes.ordinal_split(path),
+            'pairs': [{'id': i + 1, 'kind': kind,
+                       'a': [round(float(a[0]), 1), round(float(a[1]), 1)],
+                       'b': [round(float(b[0]), 1), round(float(b[1]), 1)]}
+                      for i, (kind, a, b) in enumerate(pairs)]}
+
+
+def cmd_sample(args):
+    root = scenes.photo_root()
+    photos = [sample_photo(p, p.relative_to(root).as_posix()) for p in scenes.list_photos()]
+    PAIRS_FILE.write_text(json.dumps({'seed': SEED, 'photos': photos}, indent=1) + '\n')
+    n = sum(len(p['pairs']) for p in photos)
+    print(f'{PAIRS_FILE}: {n} pairs on {len(photos)} photos')
+
+
+# ----------------------------------------------------------------------------------
+# Marked images
+
+def font(size):
+    try:
+        return ImageFont.truetype('/usr/share/fonts/truetype/dejavu/DejaVuSans-Bold.ttf', size)
+    except OSError:
+        return ImageFont.load_default()
+
+
+def mark(draw, xy, shape, colour, text, radius, text_size):
+    x, y = xy
+    box = [x - radius, y - radius, x + radius, y + radius]
+    for width, c in ((4, (0, 0, 0)), (2, colour)):
+        (draw.ellipse if shape == 'circle' else draw.rectangle)(box, outline=c, width=width)
+    draw.text((x + radius + 2, y - radius - text_size), text, fill=colour, font=font(text_size),
+              stroke_width=2, stroke_fill=(0, 0, 0))
+
+
+def draw_photo(path, entry):
+    """The photo at DISPLAY_LONG_SIDE with every pair marked (A a circle, B a square, one
+    colour per pair), and below it a ZOOM-times crop around each edge pair."""
+    photo = load_upright(path)
+    scale = DISPLAY_LONG_SIDE / max(photo.size)
+    shown = photo.resize((round(photo.width * scale), round(photo.height * scale)), Image.LANCZOS)
+    draw = ImageDraw.Draw(shown)
+    pairs = entry['pairs']
+    for pair in pairs:
+        colour = PALETTE[(pair['id'] - 1) % len(PALETTE)]
+        for key, shape in (('a', 'circle'), ('b', 'square')):
+            xy = [c * scale for c in pair[key]]
+            mark(draw, xy, shape, colour, f"{pair['id']}{key.upper()}", 7, 18)
+    crops = [zoom_crop(photo, pair) for pair in pairs if pair['kind'] == 'edge']
+    strip_h = max((c.height for c in crops), default=0)
+    canvas = Image.new('RGB', (max(shown.width, sum(c.width + 8 for c in crops)),
+                               shown.height + (strip_h + 8 if crops else 0)), (32, 32, 32))
+    canvas.paste(shown, (0, 0))
+    x = 0
+    for crop in crops:
+        canvas.paste(crop, (x, shown.height + 8))
+        x += crop.width + 8
+    return canvas
+
+
+def zoom_crop(photo, pair, half=(80, 50)):
+    """A ZOOM-times enlargement of the photo around one pair, the pair marked again."""
+    scale = ZOOM * DISPLAY_LONG_SIDE / max(photo.size) / 2
+    centre = [(pair['a'][i] + pair['b'][i]) / 2 for i in range(2)]
+    box = [centre[0] - half[0] / scale, centre[1] - half[1] / scale,
+           centre[0] + half[0] / scale, centre[1] + half[1] / scale]
+    crop = photo.crop([round(v) for v in box]).resize((2 * half[0] * 3, 2 * half[1] * 3), Image.LANCZOS)
+    k = crop.width / (box[2] - box[0])
+    draw = ImageDraw.Draw(crop)
+    colour = PALETTE[(pair['id'] - 1) % len(PALETTE)]
+    for key, shape in (('a', 'circle'), ('b', 'square')):
+        xy = [(pair[key][0] - box[0]) * k, (pair[key][1] - box[1]) * k]
+        mark(draw, xy, shape, colour, f"{pair['id']}{key.upper()}", 9, 20)
+    return crop
+
+
+def cmd_draw(args):
+    root = scenes.photo_root()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    entries = json.loads(PAIRS_FILE.read_text())['photos']
+    if args.only:
+        entries = [e for e in entries if e['photo'] in set(args.only)]
+    for entry in entries:
+        target = out / (entry['photo'].replace('/', '__').rsplit('.', 1)[0] + '.png')
+        draw_photo(root / entry['photo'], entry).save(target)
+    print(f'{out}: {len(entries)} marked images')
+
+
+# ----------------------------------------------------------------------------------
+# Merging the labels
+
+def read_labels(folder):
+    """{(photo, pair id): label} from every labels/*.tsv (photo, pair id, A|B|=)."""
+    labels = {}
+    for tsv in sorted(Path(folder).glob('*.tsv')):
+        for n, line in enumerate(tsv.read_text().splitlines(), 1):
+            if not line.strip() or line.startswith('#'):
+                continue
+            fields = line.split('\t')
+            if len(fields) != 3 or fields[2] not in LABELS or not fields[1].isdigit():
+                raise SystemExit(f'{tsv}:{n}: expected "photo<TAB>pair<TAB>A|B|=", got {line!r}')
+            key = (fields[0], int(fields[1]))
+            if key in labels and labels[key] != fields[2]:
+                raise SystemExit(f'{tsv}:{n}: {key} labelled twice, differently')
+            labels[key] = fields[2]
+    return labels
+
+
+def cmd_merge(args):
+    labels = read_labels(LABELS_DIR)
+    photos = json.loads(PAIRS_FILE.read_text())['photos']
+    known = {(e['photo'], p['id']) for e in photos for p in e['pairs']}
+    unknown = sorted(set(labels) - known)
+    if unknown:
+        raise SystemExit(f'{LABELS_DIR}: labels for pairs that pairs.json does not have: {unknown[:3]}')
+    merged = []
+    for entry in photos:
+        pairs = [dict(p, label=labels[(entry['photo'], p['id'])])
+                 for p in entry['pairs'] if (entry['photo'], p['id']) in labels]
+        if pairs:
+            merged.append({k: entry[k] for k in ('photo', 'width', 'height', 'split')} | {'pairs': pairs})
+    ORDINAL_FILE.write_text(json.dumps({'seed': SEED, 'labels': 'A: a nearer, B: b nearer, =: too close to call',
+                                        'photos': merged}, indent=1) + '\n')
+    for split in ('train', 'val'):
+        chosen = [p for e in merged if e['split'] == split for p in e['pairs']]
+        ordered = sum(p['label'] != '=' for p in chosen)
+        n_photos = sum(e['split'] == split for e in merged)
+        print(f'{split}: {n_photos} photos, {len(chosen)} labelled pairs, {ordered} ordered')
+    print(f'{ORDINAL_FILE}: {len(labels)} of {len(known)} pairs labelled')
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest='command', required=True)
+    sub.add_parser('sample', help='draw the pairs of every photo into pairs.json')
+    d = sub.add_parser('draw', help='write the marked images to label')
+    d.add_argument('--out', required=True)
+    d.add_argument('--only', nargs='*', help='photos (relative names) to draw, default all')
+    sub.add_parser('merge', help='labels/*.tsv -> ordinal.json')
+    args = ap.parse_args()
+    {'sample': cmd_sample, 'draw': cmd_draw, 'merge': cmd_merge}[args.command](args)
+
+
+if __name__ == '__main__':
+    main()
