@@ -17,6 +17,7 @@
 #include "cli/commands.h"
 #include "engine/thread_pool.h"
 #include "eval/depth_eval.h"
+#include "eval/ordinal_eval.h"
 #include "eval/slicing_eval.h"
 #include "inpaint/eval_inpaint.h"
 #include "inpaint/inpaint_net.h"
@@ -173,6 +174,7 @@ int eval_inpaint(int argc, char** argv) {
 const char kDepthUsage[] =
     "usage: ampi eval depth --images DIR --reference DIR [--model lite|heavy | --weights FILE]\n"
     "                       [--reference-is-distance] [--working-size N] [--limit N] [--threads N]\n"
+    "       ampi eval depth --images DIR --ordinal FILE [--split val|train|all] [...]\n"
     "\n"
     "The paper's depth metrics (delta < 1.25, 1.25^2, 1.25^3, RMSE, REL; Luvizon et al.,\n"
     "after Eigen et al. 2014) of the depth network on every photo under DIR (.jpg, .jpeg,\n"
@@ -193,9 +195,17 @@ const char kDepthUsage[] =
     "  REL:          mean(|a - r| / r), the reference in the denominator\n"
     "The folder's scores are the means of the images' scores.\n"
     "\n"
+    "With --ordinal, real photos are judged by point pairs labelled by eye instead\n"
+    "(training/ordinal/ordinal.json; DIR is the folder its photo names are relative to):\n"
+    "WHDR, the share of pairs labelled A or B nearer whose order the network's disparity\n"
+    "(bilinear at the two points) gets wrong; a tie counts half. Beside it the vertical\n"
+    "gradient (lower = nearer) and a constant map (0.5, every pair a tie).\n"
+    "\n"
     "  --images DIR              photos\n"
     "  --reference DIR           reference depth maps, same relative paths and names\n"
     "  --reference-is-distance   the references hold distances (larger = farther); 0 = none\n"
+    "  --ordinal FILE            an ordinal set instead of reference maps (WHDR)\n"
+    "  --split S                 the ordinal set's photos scored: val (default), train or all\n"
     "  --model M                 lite (default) or heavy: the bundled weights/depth_M.ampw\n"
     "  --weights FILE            a depth weight file instead\n"
     "  --working-size N          long side the network runs at (default: the weight file's)\n"
@@ -203,7 +213,7 @@ const char kDepthUsage[] =
     "  --threads N               worker threads (default: all hardware threads)\n";
 
 struct DepthEvalArgs {
-  std::string images, reference, model = "lite", weights;
+  std::string images, reference, ordinal, split = "val", model = "lite", weights;
   bool reference_is_distance = false;
   int working_size = 0, limit = 0, threads = 0;
 };
@@ -213,12 +223,59 @@ void print_depth_row(const std::string& method, const DepthMetrics& m, int image
               m.rel, images);
 }
 
+void print_ordinal_row(const std::string& method, const OrdinalScore& s, int photos) {
+  std::printf("%-20s %8.4f %7d %7d\n", method.c_str(), s.whdr(), s.pairs, photos);
+}
+
+int eval_depth_ordinal(const DepthEvalArgs& a) {
+  if (a.images.empty()) throw std::runtime_error("--ordinal needs --images DIR, the folder its photo names are under");
+  if (!a.reference.empty()) throw std::runtime_error("--ordinal and --reference: give one of them");
+  std::vector<OrdinalPhoto> set = read_ordinal_set(a.ordinal);
+  if (a.split != "all")
+    set.erase(std::remove_if(set.begin(), set.end(), [&](const OrdinalPhoto& e) { return e.split != a.split; }),
+              set.end());
+  if (a.limit > 0 && size_t(a.limit) < set.size()) set.resize(a.limit);
+  if (set.empty()) throw std::runtime_error(a.ordinal + ": no photos in split " + a.split);
+  for (const OrdinalPhoto& e : set)  // a missing photo stops before the network runs
+    if (!fs::is_regular_file(fs::path(a.images) / e.photo))
+      throw std::runtime_error((fs::path(a.images) / e.photo).string() + ": photo of the ordinal set not found");
+  DepthNet net = DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+  const int side = a.working_size ? a.working_size : net.working_long_side();
+  OrdinalScore network, gradient, constant;
+  for (const OrdinalPhoto& e : set) {
+    const std::string path = (fs::path(a.images) / e.photo).string();
+    const cv::Mat bgr = read_photo(path);
+    if (bgr.size() != e.size)
+      throw std::runtime_error(path + ": is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
+                               " but was labelled at " + std::to_string(e.size.width) + "x" +
+                               std::to_string(e.size.height));
+    const OrdinalScore s = score_ordinal(estimate_disparity(net, bgr, side), e);
+    network.add(s);
+    gradient.add(score_ordinal(vertical_gradient_disparity(e.size), e));
+    constant.add(score_ordinal(cv::Mat(e.size, CV_32FC1, cv::Scalar(1)), e));
+    std::fprintf(stderr, "%s: %d pairs, WHDR %.4f\n", e.photo.c_str(), s.pairs, s.whdr());
+  }
+  std::printf("%-20s %8s %7s %7s\n", "method", "WHDR", "pairs", "photos");
+  const int photos = int(set.size());
+  print_ordinal_row(a.weights.empty() ? a.model : fs::path(a.weights).filename().string(), network, photos);
+  print_ordinal_row("vertical-gradient", gradient, photos);
+  print_ordinal_row("constant", constant, photos);
+  std::printf("(WHDR: share of labelled pairs ordered wrongly, lower is better; split %s; see --help)\n",
+              a.split.c_str());
+  return 0;
+}
+
 int eval_depth(int argc, char** argv) {
   DepthEvalArgs a;
   ArgParser p("ampi eval depth", kDepthUsage);
   p.option("--images", &a.images);
   p.option("--reference", &a.reference);
   p.flag("--reference-is-distance", &a.reference_is_distance);
+  p.option("--ordinal", &a.ordinal);
+  p.option("--split", [&](const std::string& v) {
+    if (v != "val" && v != "train" && v != "all") throw std::runtime_error("--split: '" + v + "' is not val, train or all");
+    a.split = v;
+  });
   p.option("--model", [&](const std::string& v) {
     if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
     a.model = v;
@@ -228,10 +285,11 @@ int eval_depth(int argc, char** argv) {
   p.option("--limit", &a.limit, 0, 1 << 30);
   p.option("--threads", &a.threads, 0, 1024);
   if (!p.parse(argc, argv)) return 0;
+  if (a.threads > 0) set_default_threads(a.threads);
+  if (!a.ordinal.empty()) return eval_depth_ordinal(a);
   if (a.images.empty() || a.reference.empty())
     throw std::runtime_error("--images DIR and --reference DIR are required (see ampi eval depth --help)");
   if (!fs::is_directory(a.reference)) throw std::runtime_error(a.reference + ": not a directory");
-  if (a.threads > 0) set_default_threads(a.threads);
 
   std::vector<std::string> photos = list_images(a.images);
   if (a.limit > 0 && size_t(a.limit) < photos.size()) photos.resize(a.limit);
@@ -437,7 +495,7 @@ struct Mode {
 };
 
 const Mode kModes[] = {
-    {"depth", eval_depth, "depth metrics (delta, RMSE, REL) against reference maps, vs. a vertical gradient"},
+    {"depth", eval_depth, "depth metrics (delta, RMSE, REL) against reference maps, or WHDR on an ordinal set"},
     {"slicing", eval_slicing, "the paper's Table 3: adaptive vs. uniform MPIs against a dense one (SSIM, PSNR)"},
     {"inpaint", eval_inpaint, "margin filling: ampi vs. cv::inpaint Telea / Navier-Stokes, push-pull, harmonic"},
 };

@@ -84,6 +84,39 @@ expect_error "bad model" "--model: 'huge'" depth --images "$tmp/images" --refere
 expect_error "bad counts" "--counts: 'x'" slicing --images "$tmp/images" --counts 4,x
 expect_error "count out of range" "--counts: '300'" slicing --images "$tmp/images" --counts 300
 
+# An ordinal set on the example photo: pairs whose lower point is labelled nearer, so the
+# vertical gradient scores WHDR 0 and a constant map 0.5; the pair labelled "=" is left out.
+size=$(/usr/bin/python3 -c "from PIL import Image; import sys; print(*Image.open(sys.argv[1]).size)" "$photo")
+w=${size% *} h=${size#* }
+cat >"$tmp/ordinal.json" <<JSON
+{"photos": [{"photo": "sub/a.jpg", "width": $w, "height": $h, "split": "val", "pairs": [
+ {"a": [10, $((h - 10))], "b": [20, 10], "label": "A"},
+ {"a": [$((w / 2)), 5], "b": [$((w / 2)), $((h / 2))], "label": "B"},
+ {"a": [30, 30], "b": [31, 31], "label": "="}]}]}
+JSON
+if "$ampi" eval depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --threads 2 >"$tmp/out" 2>"$tmp/err"; then
+  before=$failures
+  row "$tmp/out" vertical-gradient | awk '{ exit !($2 == 0 && $3 == 2 && $4 == 1) }' ||
+    fail "ordinal: the gradient should order both pairs: $(cat "$tmp/out")"
+  row "$tmp/out" constant | awk '{ exit !($2 == 0.5) }' || fail "ordinal: constant should score 0.5: $(cat "$tmp/out")"
+  row "$tmp/out" lite | awk '{ exit !($2 >= 0 && $2 <= 1 && $3 == 2) }' || fail "ordinal: no lite row: $(cat "$tmp/out")"
+  [ "$failures" -ne "$before" ] || echo "ok: eval depth --ordinal -> $(tr '\n' ' ' <"$tmp/out")"
+else
+  fail "eval depth --ordinal: exit status $?: $(cat "$tmp/err")"
+fi
+expect_error "ordinal, empty split" "no photos in split train" \
+  depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split train
+expect_error "ordinal, bad split" "--split: 'test'" depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split test
+expect_error "ordinal and reference" "give one of them" \
+  depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --reference "$tmp/ref"
+expect_error "ordinal, missing photo" "$tmp/small/images/sub/a.jpg: photo of the ordinal set not found" \
+  depth --images "$tmp/small/images" --ordinal "$tmp/ordinal.json"
+sed 's/"width": [0-9]*/"width": 2000/' "$tmp/ordinal.json" >"$tmp/ordinal_size.json"
+expect_error "ordinal, other size" "but was labelled at 2000x" \
+  depth --images "$tmp/images" --ordinal "$tmp/ordinal_size.json"
+expect_error "ordinal, missing file" "$tmp/none.json: cannot open" \
+  depth --images "$tmp/images" --ordinal "$tmp/none.json"
+
 # Table 3 on one small photo: two rows per count, and the verdict line.
 if "$ampi" eval slicing --images "$tmp/images" --counts 2,4 --reference-planes 16 --poses 2 --max-size 128 \
     --threads 2 >"$tmp/out" 2>"$tmp/err"; then
