@@ -214,6 +214,14 @@ class ValidationSplit(unittest.TestCase):
         self.assertEqual(scenes.photo_split(first_folder[9]), 'val')
         self.assertEqual(scenes.photo_split(first_folder[8]), 'train')
 
+    def test_every_fifth_photo_is_ordinal_validation_and_no_training_texture(self):
+        photos = scenes.list_photos()
+        ordinal_val = {p for p in photos if scenes.ordinal_split(p) == 'val'}
+        self.assertLessEqual(set(scenes.list_photos('val')), ordinal_val)  # the synthetic ones too
+        folders = {p.parent for p in photos}
+        self.assertEqual(len(ordinal_val), sum(len([p for p in photos if p.parent == f]) // 5 for f in folders))
+        self.assertFalse(set(scenes.texture_pool('train').paths) & ordinal_val)
+
     def test_texture_pools_are_disjoint_and_used_by_their_seeds(self):
         train, val = scenes.texture_pool('train'), scenes.texture_pool('val')
         self.assertFalse(set(train.paths) & set(val.paths))

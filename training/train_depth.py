@@ -17,6 +17,14 @@ Data sources (--data), all yielding (rgb, disparity) pairs, rgb in [0, 1]:
                (what training/distill.py writes for pseudo-labelled photos)
 Validation uses a disjoint fixed set: scene seeds from VAL_SEED_START, or every tenth
 pair by sorted name (never trained on).
+
+Real photos (--ordinal training/ordinal/ordinal.json): each step also takes
+--ordinal-batch photos of the set's training split (random crops, flips) with the
+ranking loss of their labelled pairs (training/ordinal_data.py), weighted by
+--rank-weight, beside the paper's loss on the synthetic batch; every validation also
+measures WHDR on the set's validation photos, and best.pt is then the best WHDR.
+Batches are made ahead by --workers processes (DataLoader), so the network never waits
+for the scene renderer.
 """
 from __future__ import annotations
 
@@ -35,6 +43,7 @@ import torch.nn.functional as F
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import depth_model  # noqa: E402
 import losses  # noqa: E402
+import ordinal_data  # noqa: E402
 
 VAL_SEED_START = 1_000_000_000  # synthetic validation scenes; training seeds stay below
 VAL_EVERY_TENTH = 10
@@ -137,6 +146,36 @@ def make_batch(source, first_index: int, batch: int, validation: bool, rng: rand
             torch.stack(disps))
 
 
+class TrainingBatches(torch.utils.data.Dataset):
+    """Training batch k (from the resumed step on): the synthetic batch of step k, drawn
+    exactly as make_batch draws it, and the step's real photos with their pairs. Indexed by
+    step, so DataLoader workers make them ahead and in parallel, and a resumed run draws
+    the same batches."""
+
+    def __init__(self, source, args, size, first_step: int, ordinal_photos):
+        self.source, self.args, self.size, self.first_step = source, args, size, first_step
+        self.ordinal_photos = ordinal_photos
+
+    def __len__(self):
+        return max(0, self.args.steps - self.first_step)
+
+    def __getitem__(self, k):
+        step = self.first_step + k
+        rng = random.Random(self.args.seed * 1_000_003 + step)
+        rgb, disp = make_batch(self.source, step * self.args.batch, self.args.batch, False, rng)
+        real, pairs = None, []
+        if self.ordinal_photos:
+            samples = [ordinal_data.training_sample(rng.choice(self.ordinal_photos), self.size, rng)
+                       for _ in range(self.args.ordinal_batch)]
+            real = torch.stack([s[0] for s in samples]).contiguous(memory_format=torch.channels_last)
+            pairs = [(s[1], s[2]) for s in samples]
+        return rgb, disp, real, pairs
+
+
+def _worker_init(_):
+    torch.set_num_threads(1)  # the network's threads are the main process's
+
+
 # ---- metrics ------------------------------------------------------------------------------
 
 METRIC_NAMES = ("delta1.25", "delta1.25^2", "delta1.25^3", "rmse", "rel")
@@ -173,6 +212,20 @@ def validate(model, source, count: int, batch: int):
         batches += 1
     model.train()
     return total / batches, dict(zip(METRIC_NAMES, np.mean(metrics, axis=0).tolist()))
+
+
+@torch.no_grad()
+def validate_ordinal(model, photos, size):
+    """WHDR of the network on the ordinal validation photos, each resized to size."""
+    model.eval()
+    wrong, pairs = 0.0, 0
+    for photo in photos:
+        rgb, points, signs = ordinal_data.validation_sample(photo, size)
+        w, n = ordinal_data.whdr_counts(model(rgb[None].contiguous(memory_format=torch.channels_last))[-1][0],
+                                        points, signs)
+        wrong, pairs = wrong + w, pairs + n
+    model.train()
+    return wrong / max(pairs, 1)
 
 
 # ---- checkpoints --------------------------------------------------------------------------
@@ -220,6 +273,11 @@ def train(args):
     run.mkdir(parents=True, exist_ok=True)
     size = parse_size(args.size)
     source = make_source(args.data, size)
+    ordinal_train = ordinal_val = None
+    if args.ordinal:
+        import scenes  # the photo folder
+        ordinal_train = ordinal_data.load_split("train", scenes.photo_root(), args.ordinal)
+        ordinal_val = ordinal_data.load_split("val", scenes.photo_root(), args.ordinal)
     ckpt_path = run / "checkpoint.pt"
     model = initial_model(args, source, size, resuming=ckpt_path.exists())
     if size[0] % model.multiple or size[1] % model.multiple:
@@ -241,40 +299,61 @@ def train(args):
     elif args.init:
         log_line(run, f"initialised {args.model} from {args.init}")
     val_count = source.validation_count(args.val_count)
-    log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data} "
-                  f"at {size[0]}x{size[1]}, batch {args.batch}, {args.threads} threads")
+    real = f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs)" if ordinal_train else ""
+    log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data}{real} "
+                  f"at {size[0]}x{size[1]}, batch {args.batch}, {args.threads} threads, {args.workers} workers")
 
     def checkpoint():
         save_checkpoint(ckpt_path, {
             "model_name": args.model, "model": model.state_dict(), "optimiser": optimiser.state_dict(),
             "scheduler": scheduler.state_dict(), "step": step, "best_val": best})
 
-    rng = random.Random(args.seed)
-    t0, seen = time.time(), 0
-    while step < args.steps:
-        rng.seed(args.seed * 1_000_003 + step)  # resumed runs draw the same flips
-        rgb, disp = make_batch(source, step * args.batch, args.batch, False, rng)
-        loss, parts = losses.depth_loss(model(rgb), disp)
+    ahead = {"num_workers": args.workers, "worker_init_fn": _worker_init, "prefetch_factor": 4} if args.workers else {}
+    batches = torch.utils.data.DataLoader(TrainingBatches(source, args, size, step, ordinal_train),
+                                          batch_size=None, shuffle=False, **ahead)
+    t0, seen, timed_from = time.time(), 0, None
+    for rgb, disp, real_rgb, pairs in batches:
+        rank = torch.zeros(())
+        if real_rgb is None:
+            loss, parts = losses.depth_loss(model(rgb), disp)
+        else:  # one pass over both: the BatchNorms see real photos too
+            outputs = model(torch.cat([rgb, real_rgb]).contiguous(memory_format=torch.channels_last))
+            n = len(rgb)
+            loss, parts = losses.depth_loss([o[:n] for o in outputs], disp)
+            rank = ordinal_data.ranking_loss(outputs[-1][n:], pairs)
+            loss = loss + args.rank_weight * rank
         optimiser.zero_grad(set_to_none=True)
         loss.backward()
         optimiser.step()
         step += 1
         seen += 1
+        trained_until = time.time()
+        if seen == 1:
+            timed_from = trained_until  # the rate leaves out start-up and the first step
         if step % args.log_every == 0:
             log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
-                          f"lr {optimiser.param_groups[0]['lr']:.2e} {(time.time() - t0) / seen:.2f} s/step")
+                          f"rank {float(rank):.4f} lr {optimiser.param_groups[0]['lr']:.2e} "
+                          f"{(time.time() - t0) / seen:.2f} s/step")
         if step % args.val_every == 0 or step == args.steps:
             val_loss, metrics = validate(model, source, val_count, args.batch)
             scheduler.step(val_loss)
-            if val_loss < best:  # the weights worth exporting, kept apart from the latest
-                best = val_loss
+            whdr = validate_ordinal(model, ordinal_val, size) if ordinal_val else None
+            score = whdr if whdr is not None else val_loss  # what best.pt keeps the lowest of
+            if score < best:  # the weights worth exporting, kept apart from the latest
+                best = score
                 save_checkpoint(run / "best.pt", {"model_name": args.model, "model": model.state_dict(),
-                                                  "step": step, "val_loss": val_loss, "metrics": metrics})
+                                                  "step": step, "val_loss": val_loss, "metrics": metrics,
+                                                  "ordinal_whdr": whdr})
             shown = " ".join(f"{name} {value:.4f}" for name, value in metrics.items())
+            if whdr is not None:
+                shown += f" ordinal_whdr {whdr:.4f}"
             log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
         if step % args.checkpoint_every == 0 or step == args.steps:
             checkpoint()
     log_line(run, f"done at step {step}")
+    samples = args.batch + (args.ordinal_batch if ordinal_train else 0)
+    return {"steps": seen - 1, "seconds": trained_until - timed_from if seen else 0.0,
+            "samples_per_step": samples}
 
 
 def main(argv=None):
@@ -294,7 +373,12 @@ def main(argv=None):
     p.add_argument("--val-count", type=int, default=32)
     p.add_argument("--checkpoint-every", type=int, default=50)
     p.add_argument("--init", help="start from this checkpoint's weights (fine-tuning)")
-    train(p.parse_args(argv))
+    p.add_argument("--workers", type=int, default=1, help="processes making batches ahead (0: in the loop)")
+    p.add_argument("--ordinal", help="ordinal set (training/ordinal/ordinal.json): ranking loss on its "
+                                     "training photos, WHDR on its validation photos")
+    p.add_argument("--ordinal-batch", type=int, default=4, help="real photos per step with --ordinal")
+    p.add_argument("--rank-weight", type=float, default=1.0, help="weight of the ranking loss")
+    return train(p.parse_args(argv))
 
 
 if __name__ == "__main__":

@@ -1,0 +1,114 @@
+"""Real photos with labelled point pairs (training/ordinal/ordinal.json) for training and
+validating the depth networks: the ranking loss and WHDR.
+
+The ranking loss is Chen et al. 2016's ("Single-Image Depth Perception in the Wild") for
+ordered pairs: log(1 + exp(-s (z_a - z_b))), s = +1 when A is nearer, on the predicted
+disparity z (larger = nearer) read bilinearly at the two points. Pairs labelled too close
+to call are left out here (the set keeps them). WHDR is the share of ordered pairs the
+prediction orders wrongly, a tie counting half, as `ampi eval depth --ordinal` reports it.
+"""
+from __future__ import annotations
+
+import json
+import random
+from pathlib import Path
+
+import numpy as np
+import torch
+import torch.nn.functional as F
+from PIL import Image, ImageOps
+
+ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json"
+PHOTO_MAX_SIDE = 640      # photos are kept decoded at this size (training crops are smaller)
+CROP_SHARE = (0.7, 1.0)   # a training crop keeps this share of each side
+
+
+class OrdinalPhoto:
+    def __init__(self, rgb: np.ndarray, points: np.ndarray, signs: np.ndarray):
+        self.rgb = rgb          # H x W x 3 uint8, downscaled
+        self.points = points    # P x 2 x 2: (a, b) x (x, y), in the downscaled pixels
+        self.signs = signs      # P: +1 A nearer, -1 B nearer
+
+
+def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE):
+    """The photos of one split ('train' or 'val') with their ordered pairs."""
+    entries = json.loads(Path(ordinal_file).read_text())["photos"]
+    photos = []
+    for entry in entries:
+        if entry["split"] != split:
+            continue
+        pairs = [p for p in entry["pairs"] if p["label"] in ("A", "B")]
+        if not pairs:
+            continue
+        with Image.open(Path(photo_root) / entry["photo"]) as image:
+            image = ImageOps.exif_transpose(image).convert("RGB")
+        if image.size != (entry["width"], entry["height"]):
+            raise RuntimeError(f"{entry['photo']}: is {image.size}, labelled at {entry['width']}x{entry['height']}")
+        scale = min(1.0, PHOTO_MAX_SIDE / max(image.size))
+        size = (round(image.width * scale), round(image.height * scale))
+        rgb = np.asarray(image.resize(size, Image.BILINEAR, reducing_gap=2.0))
+        points = np.array([[p["a"], p["b"]] for p in pairs], np.float32)
+        points = (points + 0.5) * np.array([size[0] / image.width, size[1] / image.height], np.float32) - 0.5
+        signs = np.array([1.0 if p["label"] == "A" else -1.0 for p in pairs], np.float32)
+        photos.append(OrdinalPhoto(rgb, points, signs))
+    if not photos:
+        raise RuntimeError(f"{ordinal_file}: no labelled photos in split {split}")
+    return photos
+
+
+def _resize(rgb: np.ndarray, size):
+    return np.array(Image.fromarray(rgb).resize(size, Image.BILINEAR, reducing_gap=2.0))
+
+
+def training_sample(photo: OrdinalPhoto, size, rng: random.Random):
+    """A random crop (CROP_SHARE of each side), resized to size = (w, h), flipped half the
+    time: (rgb [3, h, w] float in [0, 1], points [P, 2, 2] in its pixels, signs [P]).
+    Pairs with a point outside the crop are dropped."""
+    H, W = photo.rgb.shape[:2]
+    cw, ch = round(W * rng.uniform(*CROP_SHARE)), round(H * rng.uniform(*CROP_SHARE))
+    x0, y0 = rng.randint(0, W - cw), rng.randint(0, H - ch)
+    rgb = _resize(photo.rgb[y0:y0 + ch, x0:x0 + cw], size)
+    points = photo.points - np.array([x0, y0], np.float32)
+    keep = ((points >= -0.5) & (points <= np.array([cw, ch], np.float32) - 0.5)).all(axis=(1, 2))
+    points = (points[keep] + 0.5) * np.array([size[0] / cw, size[1] / ch], np.float32) - 0.5
+    if rng.random() < 0.5:
+        rgb = rgb[:, ::-1]
+        points[..., 0] = size[0] - 1 - points[..., 0]
+    image = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1).float() / 255.0
+    return image, torch.from_numpy(points), torch.from_numpy(photo.signs[keep])
+
+
+def validation_sample(photo: OrdinalPhoto, size):
+    """The whole photo resized to size, its pairs mapped along."""
+    H, W = photo.rgb.shape[:2]
+    rgb = _resize(photo.rgb, size)
+    points = (photo.points + 0.5) * np.array([size[0] / W, size[1] / H], np.float32) - 0.5
+    image = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1).float() / 255.0
+    return image, torch.from_numpy(points), torch.from_numpy(photo.signs)
+
+
+def read_at(disparity: torch.Tensor, points: torch.Tensor) -> torch.Tensor:
+    """disparity [1, H, W] read bilinearly at points [P, 2, 2] (pixel x, y): [P, 2]."""
+    h, w = disparity.shape[-2:]
+    grid = torch.stack([(points[..., 0] + 0.5) / w * 2 - 1, (points[..., 1] + 0.5) / h * 2 - 1], -1)
+    return F.grid_sample(disparity[None], grid[None], mode="bilinear", padding_mode="border",
+                         align_corners=False)[0, 0]
+
+
+def ranking_loss(disparity: torch.Tensor, pairs) -> torch.Tensor:
+    """Mean log(1 + exp(-s (z_a - z_b))) over every pair of the batch. disparity
+    [N, 1, H, W]; pairs: N (points, signs) tuples."""
+    terms = []
+    for z, (points, signs) in zip(disparity, pairs):
+        if len(signs):
+            values = read_at(z, points)
+            terms.append(F.softplus(-signs * (values[:, 0] - values[:, 1])))
+    return torch.cat(terms).mean() if terms else disparity.new_zeros(())
+
+
+def whdr_counts(disparity: torch.Tensor, points: torch.Tensor, signs: torch.Tensor):
+    """(wrong, pairs) of one map [1, H, W]; a tie counts half."""
+    values = read_at(disparity, points)
+    predicted = torch.sign(values[:, 0] - values[:, 1])
+    wrong = torch.where(predicted == 0, torch.full_like(signs, 0.5), (predicted != signs).float())
+    return float(wrong.sum()), int(len(signs))

@@ -1,0 +1,88 @@
+"""Tests of training/ordinal_data.py: the ranking loss, WHDR, the crops' point mapping,
+and reading an ordinal set."""
+import json
+import random
+import sys
+import tempfile
+import unittest
+from pathlib import Path
+
+import numpy as np
+import torch
+from PIL import Image
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import ordinal_data  # noqa: E402
+
+
+def coordinate_photo(w, h):
+    """A photo whose red channel is x // 4 and green channel y // 4, to find points again."""
+    y, x = np.mgrid[0:h, 0:w]
+    return np.stack([x // 4, y // 4, np.zeros_like(x)], -1).astype(np.uint8)
+
+
+class RankingAndWhdr(unittest.TestCase):
+    def setUp(self):
+        ramp = torch.arange(12, dtype=torch.float32).view(1, 12, 1).expand(1, 12, 16)  # lower = nearer
+        self.disparity = ramp.clone()
+        self.points = torch.tensor([[[3.0, 10.0], [5.0, 1.0]], [[8.0, 2.0], [8.0, 9.0]]])
+
+    def test_whdr_of_right_wrong_and_tied_orders(self):
+        right = torch.tensor([1.0, -1.0])
+        self.assertEqual(ordinal_data.whdr_counts(self.disparity, self.points, right), (0.0, 2))
+        self.assertEqual(ordinal_data.whdr_counts(self.disparity, self.points, -right), (2.0, 2))
+        self.assertEqual(ordinal_data.whdr_counts(torch.ones(1, 12, 16), self.points, right), (1.0, 2))
+
+    def test_ranking_loss_is_small_when_right_and_its_gradient_pushes_towards_the_label(self):
+        signs = torch.tensor([1.0, -1.0])
+        right = ordinal_data.ranking_loss(self.disparity[None], [(self.points, signs)])
+        wrong = ordinal_data.ranking_loss(self.disparity[None], [(self.points, -signs)])
+        self.assertLess(float(right), 0.01)
+        self.assertGreater(float(wrong), 5)
+        flat = torch.zeros(1, 1, 12, 16, requires_grad=True)
+        ordinal_data.ranking_loss(flat, [(self.points[:1], signs[:1])]).backward()
+        self.assertLess(float(flat.grad[0, 0, 10, 3]), 0)   # A (labelled nearer) pushed up
+        self.assertGreater(float(flat.grad[0, 0, 1, 5]), 0)  # B pushed down
+
+    def test_a_batch_without_pairs_costs_nothing(self):
+        self.assertEqual(float(ordinal_data.ranking_loss(torch.zeros(2, 1, 4, 4), [])), 0.0)
+
+
+class Crops(unittest.TestCase):
+    def test_points_follow_the_crop_resize_and_flip(self):
+        rgb = coordinate_photo(320, 240)
+        points = np.array([[[17.0, 33.0], [300.0, 200.0]], [[160.0, 120.0], [40.0, 220.0]]], np.float32)
+        photo = ordinal_data.OrdinalPhoto(rgb, points, np.array([1.0, -1.0], np.float32))
+        for seed in range(20):
+            image, mapped, signs = ordinal_data.training_sample(photo, (64, 48), random.Random(seed))
+            self.assertEqual(tuple(image.shape), (3, 48, 64))
+            for pair, sign in zip(mapped, signs):
+                original = points[0] if sign > 0 else points[1]
+                for (x, y), (ox, oy) in zip(pair.tolist(), original):
+                    pixel = image[:, min(47, round(y)), min(63, round(x))] * 255
+                    # one 64-px-wide cell is at most 8 px of the photo: within 3 of x // 4
+                    self.assertLess(abs(float(pixel[0]) - ox / 4), 3.5)
+                    self.assertLess(abs(float(pixel[1]) - oy / 4), 3.5)
+
+
+class Reading(unittest.TestCase):
+    def test_load_split_keeps_ordered_pairs_and_checks_the_size(self):
+        with tempfile.TemporaryDirectory() as folder:
+            root = Path(folder)
+            Image.fromarray(coordinate_photo(100, 80)).save(root / "a.png")
+            pairs = [{"a": [10, 70], "b": [50, 5], "label": "A"}, {"a": [1, 1], "b": [2, 2], "label": "="}]
+            entry = {"photo": "a.png", "width": 100, "height": 80, "split": "val", "pairs": pairs}
+            (root / "set.json").write_text(json.dumps({"photos": [entry]}))
+            [photo] = ordinal_data.load_split("val", root, root / "set.json")
+            self.assertEqual(photo.points.shape, (1, 2, 2))
+            self.assertEqual(photo.signs.tolist(), [1.0])
+            with self.assertRaisesRegex(RuntimeError, "no labelled photos in split train"):
+                ordinal_data.load_split("train", root, root / "set.json")
+            entry["width"] = 120
+            (root / "set.json").write_text(json.dumps({"photos": [entry]}))
+            with self.assertRaisesRegex(RuntimeError, "a.png: is \\(100, 80\\), labelled at 120x80"):
+                ordinal_data.load_split("val", root, root / "set.json")
+
+
+if __name__ == "__main__":
+    unittest.main()
