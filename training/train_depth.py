@@ -199,12 +199,13 @@ def aligned_metrics(pred: torch.Tensor, target: torch.Tensor) -> dict:
 
 
 @torch.no_grad()
-def validate(model, source, count: int, batch: int):
+def validate(model, source, count: int, batch: int, device="cpu"):
     """(mean loss, mean metrics) over the fixed validation set."""
     model.eval()
     total, metrics, batches = 0.0, [], 0
     for first in range(0, count, batch):
         rgb, disp = make_batch(source, first, min(batch, count - first), True, random.Random(0))
+        rgb, disp = rgb.to(device), disp.to(device)
         outputs = model(rgb)
         loss, _ = losses.depth_loss(outputs, disp)
         total += float(loss)
@@ -215,14 +216,14 @@ def validate(model, source, count: int, batch: int):
 
 
 @torch.no_grad()
-def validate_ordinal(model, photos, size):
+def validate_ordinal(model, photos, size, device="cpu"):
     """WHDR of the network on the ordinal validation photos, each resized to size."""
     model.eval()
     wrong, pairs = 0.0, 0
     for photo in photos:
         rgb, points, signs = ordinal_data.validation_sample(photo, size)
-        w, n = ordinal_data.whdr_counts(model(rgb[None].contiguous(memory_format=torch.channels_last))[-1][0],
-                                        points, signs)
+        rgb = rgb[None].to(device).contiguous(memory_format=torch.channels_last)
+        w, n = ordinal_data.whdr_counts(model(rgb)[-1][0].cpu(), points, signs)
         wrong, pairs = wrong + w, pairs + n
     model.train()
     return wrong / max(pairs, 1)
@@ -255,7 +256,7 @@ def initial_model(args, source, size, resuming: bool):
         return depth_model.build(args.model)
     if not args.init.endswith(".ampw"):
         model = depth_model.build(args.model)
-        model.load_state_dict(torch.load(args.init)["model"])
+        model.load_state_dict(torch.load(args.init, map_location="cpu")["model"])
         return model
     import export_depth
     model = export_depth.import_ampw(args.init)
@@ -282,13 +283,13 @@ def train(args):
     model = initial_model(args, source, size, resuming=ckpt_path.exists())
     if size[0] % model.multiple or size[1] % model.multiple:
         raise SystemExit(f"--size {args.size}: both sides must be multiples of {model.multiple}")
-    model = model.to(memory_format=torch.channels_last)
+    model = model.to(args.device, memory_format=torch.channels_last)
     optimiser = torch.optim.Adam(model.parameters(), lr=args.lr)
     scheduler = torch.optim.lr_scheduler.ReduceLROnPlateau(
         optimiser, factor=0.2, patience=args.patience)
     step, best = 0, math.inf
     if ckpt_path.exists():
-        ckpt = torch.load(ckpt_path)
+        ckpt = torch.load(ckpt_path, map_location=args.device)
         if ckpt["model_name"] != args.model:
             raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
         model.load_state_dict(ckpt["model"])
@@ -313,10 +314,13 @@ def train(args):
                                           batch_size=None, shuffle=False, **ahead)
     t0, seen, timed_from = time.time(), 0, None
     for rgb, disp, real_rgb, pairs in batches:
+        rgb, disp = rgb.to(args.device, non_blocking=True), disp.to(args.device, non_blocking=True)
         rank = torch.zeros(())
         if real_rgb is None:
             loss, parts = losses.depth_loss(model(rgb), disp)
         else:  # one pass over both: the BatchNorms see real photos too
+            real_rgb = real_rgb.to(args.device, non_blocking=True)
+            pairs = [(points.to(args.device), signs.to(args.device)) for points, signs in pairs]
             outputs = model(torch.cat([rgb, real_rgb]).contiguous(memory_format=torch.channels_last))
             n = len(rgb)
             loss, parts = losses.depth_loss([o[:n] for o in outputs], disp)
@@ -334,10 +338,11 @@ def train(args):
             log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
                           f"rank {float(rank):.4f} lr {optimiser.param_groups[0]['lr']:.2e} "
                           f"{(time.time() - t0) / seen:.2f} s/step")
-        if step % args.val_every == 0 or step == args.steps:
-            val_loss, metrics = validate(model, source, val_count, args.batch)
+        out_of_time = args.minutes > 0 and time.time() - t0 >= 60 * args.minutes
+        if step % args.val_every == 0 or step == args.steps or out_of_time:
+            val_loss, metrics = validate(model, source, val_count, args.batch, args.device)
             scheduler.step(val_loss)
-            whdr = validate_ordinal(model, ordinal_val, size) if ordinal_val else None
+            whdr = validate_ordinal(model, ordinal_val, size, args.device) if ordinal_val else None
             score = whdr if whdr is not None else val_loss  # what best.pt keeps the lowest of
             if score < best:  # the weights worth exporting, kept apart from the latest
                 best = score
@@ -348,9 +353,13 @@ def train(args):
             if whdr is not None:
                 shown += f" ordinal_whdr {whdr:.4f}"
             log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
-        if step % args.checkpoint_every == 0 or step == args.steps:
+        if step % args.checkpoint_every == 0 or step == args.steps or out_of_time:
             checkpoint()
-    log_line(run, f"done at step {step}")
+        if out_of_time:
+            log_line(run, f"stopped after {args.minutes:g} minutes at step {step}")
+            break
+    else:
+        log_line(run, f"done at step {step}")
     samples = args.batch + (args.ordinal_batch if ordinal_train else 0)
     return {"steps": seen - 1, "seconds": trained_until - timed_from if seen else 0.0,
             "samples_per_step": samples}
@@ -373,6 +382,9 @@ def main(argv=None):
     p.add_argument("--val-count", type=int, default=32)
     p.add_argument("--checkpoint-every", type=int, default=50)
     p.add_argument("--init", help="start from this checkpoint's weights (fine-tuning)")
+    p.add_argument("--device", default="cpu", help="cpu, or cuda on a GPU machine")
+    p.add_argument("--minutes", type=float, default=0,
+                   help="stop after this many minutes, validated and checkpointed (0: run to --steps)")
     p.add_argument("--workers", type=int, default=1, help="processes making batches ahead (0: in the loop)")
     p.add_argument("--ordinal", help="ordinal set (training/ordinal/ordinal.json): ranking loss on its "
                                      "training photos, WHDR on its validation photos")
