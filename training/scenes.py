@@ -42,6 +42,11 @@ NEAR_CLIP = 0.05                  # metres: nothing nearer than this is rendered
 SHADOW_BIAS = 1e-3                # metres: shadow rays start this far along the light
 MIN_GRAZING_COS = 0.15            # caps the texture footprint growth at grazing angles
 DEFAULT_SIZE = (384, 288)
+OBJECT_TEXTURE_SKIP_TOP = 0.3     # object crops start below the top 30% of a photo (its sky)
+GROUND_TEXTURE_SKIP_TOP = 0.5     # ground crops from the photo's lower half where they fit
+WALL_STREAK_ODDS = 0.3            # walls and facades streaked vertically this often
+DEFOCUS_ODDS = 0.3                # photos with a visible depth of field
+NEAR_FOCUS_ODDS = 0.7             # of those, focused on the nearest surfaces
 
 
 # ----------------------------------------------------------------------------------
@@ -446,13 +451,14 @@ class Material:
     crop: tuple = (0, 0, 1, 1)      # x, y, w, h of the tiled region in level-0 texels
     texels_per_metre: float = 100.0
     offset: tuple = (0.0, 0.0)      # texels
+    stretch: float = 1.0            # > 1: the crop drawn taller than wide, vertical streaks
 
     def albedo(self, uv, metres_per_pixel):
         count = np.size(uv[0])
         if self.pyramid is None:
             return np.broadcast_to(self.tint.astype(np.float32)[:, None], (3, count))
         tu = uv[0] * self.texels_per_metre + self.offset[0]
-        tv = -uv[1] * self.texels_per_metre + self.offset[1]     # image rows grow downwards
+        tv = -uv[1] * (self.texels_per_metre / self.stretch) + self.offset[1]   # rows grow downwards
         footprint = np.maximum(metres_per_pixel * self.texels_per_metre, 1e-6)
         levels = np.clip(np.rint(np.log2(footprint)), 0, len(self.pyramid) - 1).astype(np.uint8)
         lowest = int(levels.min())
@@ -667,7 +673,10 @@ def defocus(image, disparity, rng):
     Blurred copies come from 2x, 4x and 8x box-downsampled images upsampled bilinearly
     (blur radii of about 1, 3 and 7 pixels); each pixel blends the two nearest copies."""
     scale = max(float(np.percentile(disparity[::4, ::4], 99)), 1e-6)
-    focus = disparity[rng.integers(disparity.shape[0]), rng.integers(disparity.shape[1])] / scale
+    if rng.random() < NEAR_FOCUS_ODDS:   # focused on a near subject: blur grows with distance
+        focus = float(np.percentile(disparity[::4, ::4], rng.uniform(85, 99))) / scale
+    else:
+        focus = disparity[rng.integers(disparity.shape[0]), rng.integers(disparity.shape[1])] / scale
     strength = rng.uniform(4, 14)           # blur radius in pixels per unit normalised disparity
     radius = np.minimum(np.abs(disparity * np.float32(1 / scale) - focus) * np.float32(strength), 7)
     level = np.log2(1 + radius)             # 0 (sharp) .. 3
@@ -724,7 +733,7 @@ def photograph(radiance, disparity, rng):
     exposure = rng.uniform(0.75, 1.05) / max(float(np.percentile(luminance, 98)), 1e-4)
     gains = (np.exp(rng.normal(0, 0.06, 3)) * exposure).astype(np.float32)   # white balance
     image = np.minimum(radiance * gains[:, None, None], 1)
-    if rng.random() < 0.2:
+    if rng.random() < DEFOCUS_ODDS:
         image = defocus(image, disparity, rng)
     image = optical_softness(image, np.float32(rng.uniform(0.08, 0.22)))
     image = encode(image, rng.uniform(0.8, 1.25) / DISPLAY_GAMMA)    # display gamma, randomised
@@ -801,6 +810,23 @@ def figure_mask(rng, rows=128, cols=64):
     return head | torso | legs | arms
 
 
+def animal_mask(rng, rows=64, cols=112):
+    """A four-legged animal's side view: body, neck and head, legs, tail."""
+    y, x = np.mgrid[0:1:rows * 1j, 0:1:cols * 1j]
+    facing = 1 if rng.random() < 0.5 else -1
+    x = 0.5 + facing * (x - 0.5)
+    belly = rng.uniform(0.5, 0.62)
+    body = ((x - 0.5) / 0.3) ** 2 + ((y - (belly - 0.16)) / 0.17) ** 2 < 1
+    neck_top = rng.uniform(0.05, 0.25)
+    neck = (x > 0.7) & (x < 0.82) & (y > neck_top + 0.05) & (y < belly - 0.15) & (np.abs(x - 0.76 + 0.2 * (y - belly)) < 0.07)
+    head = ((x - 0.85) / 0.1) ** 2 + ((y - neck_top - 0.06) / 0.07) ** 2 < 1
+    legs = np.zeros_like(body)
+    for centre in (0.27, 0.36, 0.64, 0.73):
+        legs |= (np.abs(x - centre - rng.uniform(-0.03, 0.03)) < 0.035) & (y > belly - 0.2)
+    tail = (x < 0.22) & (x > 0.12) & (np.abs(y - (belly - 0.3) - 0.8 * (0.22 - x)) < 0.03)
+    return body | neck | head | legs | tail
+
+
 def skyline_mask(rng, rows=64, cols=256, blocky=False):
     """Columns filled from the bottom to a ridge (smooth) or roof-line (blocky) profile."""
     if blocky:
@@ -817,7 +843,7 @@ def skyline_mask(rng, rows=64, cols=256, blocky=False):
 
 
 def random_mask(rng, kind):
-    makers = {'blob': blob_mask, 'foliage': foliage_mask, 'figure': figure_mask}
+    makers = {'blob': blob_mask, 'foliage': foliage_mask, 'figure': figure_mask, 'animal': animal_mask}
     while True:      # a rare draw covers almost nothing: draw again
         mask = makers[kind](rng)
         if mask.mean() > 0.08:
@@ -853,18 +879,28 @@ class SceneSampler:
         self.z_far = 50.0
 
     # -- materials
-    def photo_material(self, span_m):
-        """A crop of a random photo, tiled so that the crop spans about span_m metres."""
+    def photo_material(self, span_m, skip_top=0.0, stretch=1.0):
+        """A crop of a random photo, tiled so that the crop spans about span_m metres.
+        skip_top: the crop starts below this share of the photo's height where it can
+        (the sky of a photo is no texture for a near object). stretch: the crop drawn that
+        many times taller than wide."""
         rng = self.rng
         pyramid = self.pool.pyramids[rng.integers(len(self.pool.pyramids))]
         h, w = pyramid[0].shape[1:]
         cw = max(8.0, rng.uniform(0.2, 0.9) * w)
         ch = max(8.0, min(h, cw * rng.uniform(0.6, 1.4)))
-        crop = (rng.uniform(0, w - cw), rng.uniform(0, h - ch), cw, ch)
+        top = min(skip_top * h, h - ch)
+        crop = (rng.uniform(0, w - cw), rng.uniform(top, h - ch), cw, ch)
         tint = (np.exp(rng.normal(0, 0.08, 3)) * rng.uniform(0.8, 1.1)).astype(np.float32)
         texels_per_metre = cw / (span_m * rng.uniform(0.6, 1.6))
         offset = (rng.uniform(0, cw), rng.uniform(0, ch))
-        return Material(tint, pyramid, crop, texels_per_metre, offset)
+        return Material(tint, pyramid, crop, texels_per_metre, offset, stretch)
+
+    def wall_material(self, span_m):
+        """A wall's texture: now and then streaked vertically (shelves, curtains, panels),
+        so that vertical texture on a flat surface is no sign of depth."""
+        stretch = log_uniform(self.rng, 4, 16) if self.rng.random() < WALL_STREAK_ODDS else 1.0
+        return self.photo_material(span_m, stretch=stretch)
 
     def flat_material(self):
         """A plain paint: mostly muted colours, now and then a saturated one."""
@@ -875,7 +911,9 @@ class SceneSampler:
         return Material((brightness * (1 - saturation + saturation * hue)).astype(np.float32))
 
     def object_material(self, size_m):
-        return self.photo_material(size_m) if self.rng.random() < 0.82 else self.flat_material()
+        if self.rng.random() < 0.82:
+            return self.photo_material(size_m, skip_top=OBJECT_TEXTURE_SKIP_TOP)
+        return self.flat_material()
 
     # -- placement
     def ground_spot(self, near=0.8):
@@ -954,6 +992,9 @@ class SceneSampler:
         if kind == 'figure':
             height = rng.uniform(1.4, 1.9) * (1 + z / 40)
             width = height * 0.5
+        elif kind == 'animal':
+            height = rng.uniform(0.4, 1.6) * (1 + z / 40)
+            width = height * rng.uniform(1.3, 2.0)
         else:
             height = self.object_size(z) * rng.uniform(0.6, 1.5)
             width = height * rng.uniform(0.6, 1.6)
@@ -1027,8 +1068,10 @@ class SceneSampler:
             spots.append((x, z))
             kind = rng.choice(OBJECT_KINDS, p=OBJECT_KIND_ODDS)
             objects += getattr(self, kind)(x, z)
-        if rng.random() < 0.4:       # a person-like subject in the middle distance
-            objects += self.cutout(rng.normal(0, 1.0), rng.uniform(2.0, 9.0), kind='figure')
+        if rng.random() < 0.55:      # a person-like subject, in front of the background
+            objects += self.cutout(rng.normal(0, 1.0), rng.uniform(1.5, 8.0), kind='figure')
+        if rng.random() < 0.25:      # an animal-like one
+            objects += self.cutout(rng.normal(0, 1.0), rng.uniform(1.5, 10.0), kind='animal')
         if rng.random() < 0.3:       # a large near occluder entering from the frame's edge
             z = rng.uniform(0.6, 1.8)
             x = math.copysign(z * self.half_tan * rng.uniform(0.6, 1.1), rng.normal())
@@ -1037,7 +1080,8 @@ class SceneSampler:
 
     # -- backgrounds
     def ground(self):
-        return SceneObject(ground_plane(), self.photo_material(log_uniform(self.rng, 1.5, 10.0)), False)
+        return SceneObject(ground_plane(), self.photo_material(log_uniform(self.rng, 1.5, 10.0),
+                                                               skip_top=GROUND_TEXTURE_SKIP_TOP), False)
 
     def backdrop(self, distance, blocky):
         """A far cut-out across the view: hills, a tree line or a city roof-line."""
@@ -1056,7 +1100,7 @@ class SceneSampler:
         x = rng.uniform(-1, 1) * distance * self.half_tan
         mask = skyline_mask(rng, blocky=True) if rng.random() < 0.5 else None
         shape = vertical_quad((x, height / 2, distance), width, height, rng.uniform(-0.8, 0.8), mask)
-        return SceneObject(shape, self.photo_material(rng.uniform(3, 12)))
+        return SceneObject(shape, self.wall_material(rng.uniform(3, 12)))
 
     def open_land(self):
         rng = self.rng
@@ -1079,7 +1123,7 @@ class SceneSampler:
                 height = rng.uniform(5, 30)
                 shape = Quad((x, height / 2, length / 2 - 2), (0, 0, 1), (0, 1, 0), length / 2, height / 2,
                              skyline_mask(rng, cols=512, blocky=True))
-                parts.append(SceneObject(shape, self.photo_material(rng.uniform(4, 15)), False))
+                parts.append(SceneObject(shape, self.wall_material(rng.uniform(4, 15)), False))
                 self.x_limit = min(self.x_limit, abs(x) - 0.5)
         parts.append(self.backdrop(length + rng.uniform(0, 200), blocky=rng.random() < 0.6))
         return parts
@@ -1101,8 +1145,10 @@ class SceneSampler:
         if has_ceiling:
             walls.append(Quad((0, ceiling, 0), (1, 0, 0), (0, 0, 1), np.inf, np.inf))
         parts = [self.ground()]
-        for wall in walls:
-            parts.append(SceneObject(wall, self.photo_material(rng.uniform(2, 8)), False))
+        for wall in walls[:3]:
+            parts.append(SceneObject(wall, self.wall_material(rng.uniform(2, 8)), False))
+        for ceiling_quad in walls[3:]:
+            parts.append(SceneObject(ceiling_quad, self.photo_material(rng.uniform(2, 8)), False))
         return parts
 
 
