@@ -1,0 +1,95 @@
+"""Training throughput of the depth network: samples per hour at 256x192 (forward,
+backward, optimiser and data included), for the old way (one thread, scenes made in the
+loop) and the current one (every core, batches made ahead by a worker), written to
+training/BENCH_TRAIN.md.
+
+    /usr/bin/python3 training/bench_train.py [--steps 20] [--model lite]
+
+Each row is a short real run of train_depth.py in a temporary folder, timed from the end
+of its first step to the end of its last (start-up, validation and checkpoints left out).
+The rows run one after another on one machine: compare them with each other, and say how
+busy the machine was (the load average is printed into the table).
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import train_depth  # noqa: E402
+
+HERE = Path(__file__).resolve().parent
+TABLE = HERE / "BENCH_TRAIN.md"
+ORDINAL = HERE / "ordinal" / "ordinal.json"
+
+
+def configurations(cores: int):
+    """(name, train_depth arguments) of each row."""
+    rows = [("1 thread, scenes in the loop, batch 4 (the former setup)",
+             ["--threads", "1", "--workers", "0", "--batch", "4"]),
+            (f"{cores} threads, 1 worker, batch 8 scenes",
+             ["--threads", str(cores), "--workers", "1", "--batch", "8"])]
+    if ORDINAL.exists():
+        rows.append((f"{cores} threads, 1 worker, batch 4 scenes + 4 real photos (ranking loss)",
+                     ["--threads", str(cores), "--workers", "1", "--batch", "4", "--ordinal", str(ORDINAL)]))
+    return rows
+
+
+def processor_name() -> str:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.machine()
+
+
+def measure(model: str, size: str, steps: int, extra):
+    with tempfile.TemporaryDirectory() as run:
+        result = train_depth.main(["--model", model, "--run", run, "--data", "scenes", "--size", size,
+                                   "--steps", str(steps + 1), "--val-every", str(10 ** 9), "--val-count", "1",
+                                   "--checkpoint-every", str(10 ** 9), "--log-every", str(10 ** 9)] + extra)
+    seconds_per_step = result["seconds"] / result["steps"]
+    return seconds_per_step, 3600 * result["samples_per_step"] / seconds_per_step
+
+
+def main():
+    p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("--model", default="lite")
+    p.add_argument("--size", default="256x192")
+    p.add_argument("--steps", type=int, default=20, help="timed steps per row")
+    p.add_argument("--output", default=str(TABLE))
+    args = p.parse_args()
+    cores = os.cpu_count() or 1
+    rows = []
+    for name, extra in configurations(cores):
+        seconds, rate = measure(args.model, args.size, args.steps, extra)
+        rows.append(f"| {name} | {seconds:.2f} | {rate:,.0f} |")
+        print(rows[-1], flush=True)
+    load = " / ".join(f"{v:.1f}" for v in os.getloadavg())
+    text = "\n".join([
+        "# Depth training throughput",
+        "",
+        f"`/usr/bin/python3 training/bench_train.py --model {args.model} --steps {args.steps}`, "
+        f"{time.strftime('%Y-%m-%d')}, {processor_name()}, {cores} cores, "
+        f"load average after the run {load} (1/5/15 min).",
+        "",
+        f"{args.model} at {args.size}: forward, backward, Adam and data, timed over {args.steps} steps after the first.",
+        "",
+        "| setup | s/step | samples/hour |",
+        "|---|---:|---:|",
+        *rows,
+        "",
+    ])
+    Path(args.output).write_text(text)
+    print(f"{args.output} written")
+
+
+if __name__ == "__main__":
+    main()
