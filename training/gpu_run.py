@@ -8,13 +8,15 @@ other: pack what the run needs here, train there, bring the checkpoint back.
     /usr/bin/python3 training/gpu_run.py unpack FILES_AT --run training/runs/lite-256
 
 The GPU machine gets only the working tree and the carried folder (64 MiB in all), not
-../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG; the scene renderer keeps
-textures at 512 px anyway) under carry/photos with the same folder and file names, so the
+../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the same folder and file names, so the
 train/validation splits are the same there, and the ordinal set with its points scaled to
 those sizes. Scenes are made by DataLoader workers on the machine's cores while the GPU
 trains; --minutes stops the run validated and checkpointed inside the command's limit.
-`unpack` puts checkpoint.pt and best.pt into the run folder and appends the run's log to
-its train.log, so the next `pack` resumes where the GPU stopped, here or there.
+Checkpoints cross slim (no Adam moments: the repository's tracked files already take
+about 44 of the 64 MiB): the run resumes with its weights, step, schedule and learning
+rate, and Adam's moments start again. `unpack` puts checkpoint.pt (and best.pt, when the
+GPU run beat the best so far) into the run folder and appends the run's log to its
+train.log, so the next `pack` resumes where the GPU stopped, here or there.
 """
 from __future__ import annotations
 
@@ -30,9 +32,21 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import scenes  # noqa: E402  (the photo folder)
 
 ROOT = Path(__file__).resolve().parents[1]
-PHOTO_LONG_SIDE = 640
+PHOTO_LONG_SIDE = 384
+TRANSFER_LIMIT = 64 * 2 ** 20   # the device tool's working tree, carried folder included
 ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
-RUN_FILES = ("checkpoint.pt", "best.pt", "train.log")
+
+
+
+def slim_checkpoint(source: Path, target: Path):
+    """The checkpoint without Adam's moments (two thirds of its size), with the learning
+    rate: what crosses to the GPU machine and back (16 MiB a returned file at most)."""
+    import torch
+    ckpt = torch.load(source, map_location="cpu")
+    slim = {k: v for k, v in ckpt.items() if k != "optimiser"}
+    if "optimiser" in ckpt:
+        slim["lr"] = ckpt["optimiser"]["param_groups"][0]["lr"]
+    torch.save(slim, target)
 
 
 def pack_photos(out: Path):
@@ -48,7 +62,7 @@ def pack_photos(out: Path):
         small = image.resize((round(image.width * scale), round(image.height * scale)), Image.LANCZOS)
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)
-        small.save(target, format="JPEG", quality=92)  # keeps the name, and so the split
+        small.save(target, format="JPEG", quality=85)  # keeps the name, and so the split
         sizes[rel] = (small.width / image.width, small.height / image.height, small.width, small.height)
     return sizes
 
@@ -76,7 +90,8 @@ def device_command(args) -> str:
             f"--threads {args.threads} --workers {args.workers} --minutes {args.minutes} "
             f"--val-every {args.val_every} --val-count {args.val_count} --checkpoint-every {args.val_every} "
             f"--ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
-            f"&& cp {c}/run/checkpoint.pt {c}/run/best.pt {c}/run/train.log $OUT/")
+            f"&& {args.python} training/gpu_run.py slim {c}/run/checkpoint.pt $OUT/checkpoint.pt "
+            f"&& cp {c}/run/train.log $OUT/ && if [ -f {c}/run/best.pt ]; then cp {c}/run/best.pt $OUT/; fi")
 
 
 def cmd_pack(args):
@@ -87,26 +102,41 @@ def cmd_pack(args):
     sizes = pack_photos(carry / "photos")
     (carry / "ordinal.json").write_text(json.dumps(scaled_ordinal_set(args.ordinal, sizes)))
     run = Path(args.run)
-    for name in ("checkpoint.pt", "best.pt"):
-        if (run / name).exists():
-            shutil.copy2(run / name, carry / "run" / name)
-    megabytes = sum(f.stat().st_size for f in carry.rglob("*") if f.is_file()) / 2 ** 20
-    print(f"{carry}: {len(sizes)} photos, the ordinal set, {run}'s checkpoint; {megabytes:.1f} MiB")
+    if (run / "checkpoint.pt").exists():  # best.pt stays here: the GPU writes one only if it beats it
+        slim_checkpoint(run / "checkpoint.pt", carry / "run" / "checkpoint.pt")
+    carried = sum(f.stat().st_size for f in carry.rglob("*") if f.is_file())
+    tree = tracked_bytes()
+    print(f"{carry}: {len(sizes)} photos, the ordinal set, {run}'s checkpoint; {carried / 2 ** 20:.1f} MiB, "
+          f"{(carried + tree) / 2 ** 20:.1f} MiB with the working tree")
+    if carried + tree > TRANSFER_LIMIT:
+        raise SystemExit(f"{carry}: the working tree and carry/ come to more than the device tool's "
+                         f"{TRANSFER_LIMIT // 2 ** 20} MiB")
     print(f"device command (carry [\"{args.carry}\"]):")
     print(device_command(args))
 
 
+def tracked_bytes() -> int:
+    import subprocess
+    names = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
+    return sum((ROOT / n).stat().st_size for n in names.decode().split("\0") if n and (ROOT / n).is_file())
+
+
+def cmd_slim(args):
+    slim_checkpoint(Path(args.source), Path(args.target))
+
+
 def cmd_unpack(args):
     came_back, run = Path(args.files_at), Path(args.run)
-    missing = [name for name in RUN_FILES if not (came_back / name).exists()]
+    missing = [name for name in ("checkpoint.pt", "train.log") if not (came_back / name).exists()]
     if missing:
         raise SystemExit(f"{came_back}: {', '.join(missing)} did not come back; the run folder is unchanged")
     run.mkdir(parents=True, exist_ok=True)
-    for name in ("checkpoint.pt", "best.pt"):
+    copied = [name for name in ("checkpoint.pt", "best.pt") if (came_back / name).exists()]
+    for name in copied:
         shutil.copy2(came_back / name, run / name)
     with open(run / "train.log", "a") as log:
         log.write((came_back / "train.log").read_text())
-    print(f"{run}: checkpoint.pt and best.pt from {came_back}, its log appended to train.log")
+    print(f"{run}: {' and '.join(copied)} from {came_back}, its log appended to train.log")
 
 
 def main():
@@ -130,8 +160,11 @@ def main():
     unpack = sub.add_parser("unpack", help="the files that came back into the run folder")
     unpack.add_argument("files_at")
     unpack.add_argument("--run", required=True)
+    slim = sub.add_parser("slim", help="a checkpoint without Adam's moments")
+    slim.add_argument("source")
+    slim.add_argument("target")
     args = p.parse_args()
-    {"pack": cmd_pack, "unpack": cmd_unpack}[args.command](args)
+    {"pack": cmd_pack, "unpack": cmd_unpack, "slim": cmd_slim}[args.command](args)
 
 
 if __name__ == "__main__":

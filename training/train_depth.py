@@ -293,10 +293,15 @@ def train(args):
         if ckpt["model_name"] != args.model:
             raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
         model.load_state_dict(ckpt["model"])
-        optimiser.load_state_dict(ckpt["optimiser"])
         scheduler.load_state_dict(ckpt["scheduler"])
         step, best = ckpt["step"], ckpt["best_val"]
-        log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}")
+        if "optimiser" in ckpt:
+            optimiser.load_state_dict(ckpt["optimiser"])
+        else:  # a slim checkpoint (training/gpu_run.py): Adam's moments start again
+            for group in optimiser.param_groups:
+                group["lr"] = ckpt["lr"]
+        log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}"
+                      + ("" if "optimiser" in ckpt else " (slim: Adam restarts)"))
     elif args.init:
         log_line(run, f"initialised {args.model} from {args.init}")
     val_count = source.validation_count(args.val_count)
