@@ -196,9 +196,11 @@ def cmd_draw(args):
 # Merging the labels
 
 def read_labels(folder):
-    """{(photo, pair id): label} from every labels/*.tsv (photo, pair id, A|B|=)."""
+    """{(photo, pair id): [label, ...]} from every labels/*.tsv (photo, pair id, A|B|=),
+    one entry per labeller (file) that labelled the pair."""
     labels = {}
     for tsv in sorted(Path(folder).glob('*.tsv')):
+        seen = {}
         for n, line in enumerate(tsv.read_text().splitlines(), 1):
             if not line.strip() or line.startswith('#'):
                 continue
@@ -206,10 +208,26 @@ def read_labels(folder):
             if len(fields) != 3 or fields[2] not in LABELS or not fields[1].isdigit():
                 raise SystemExit(f'{tsv}:{n}: expected "photo<TAB>pair<TAB>A|B|=", got {line!r}')
             key = (fields[0], int(fields[1]))
-            if key in labels and labels[key] != fields[2]:
-                raise SystemExit(f'{tsv}:{n}: {key} labelled twice, differently')
-            labels[key] = fields[2]
+            if key in seen and seen[key] != fields[2]:
+                raise SystemExit(f'{tsv}:{n}: {key} labelled twice in one file, differently')
+            seen[key] = fields[2]
+        for key, label in seen.items():
+            labels.setdefault(key, []).append(label)
     return labels
+
+
+def consensus(votes):
+    """A pair keeps an order only when every labeller who saw it gave that order;
+    anything else (a '=' beside an order, or A against B) is too close to call."""
+    return votes[0] if len(set(votes)) == 1 else '='
+
+
+def agreement(labels):
+    """Counts over pairs labelled more than once: (pairs, same label, A against B)."""
+    multi = [v for v in labels.values() if len(v) > 1]
+    same = sum(len(set(v)) == 1 for v in multi)
+    opposite = sum({'A', 'B'} <= set(v) for v in multi)
+    return len(multi), same, opposite
 
 
 def cmd_merge(args):
@@ -221,18 +239,23 @@ def cmd_merge(args):
         raise SystemExit(f'{LABELS_DIR}: labels for pairs that pairs.json does not have: {unknown[:3]}')
     merged = []
     for entry in photos:
-        pairs = [dict(p, label=labels[(entry['photo'], p['id'])])
+        pairs = [dict(p, label=consensus(labels[(entry['photo'], p['id'])]),
+                      votes=''.join(labels[(entry['photo'], p['id'])]))
                  for p in entry['pairs'] if (entry['photo'], p['id']) in labels]
         if pairs:
             merged.append({k: entry[k] for k in ('photo', 'width', 'height', 'split')} | {'pairs': pairs})
-    ORDINAL_FILE.write_text(json.dumps({'seed': SEED, 'labels': 'A: a nearer, B: b nearer, =: too close to call',
-                                        'photos': merged}, indent=1) + '\n')
+    ORDINAL_FILE.write_text(json.dumps({
+        'seed': SEED, 'labels': 'A: a nearer, B: b nearer, =: too close to call',
+        'votes': "every labeller's label; an order is kept only when all of them gave it",
+        'photos': merged}, indent=1) + '\n')
     for split in ('train', 'val'):
         chosen = [p for e in merged if e['split'] == split for p in e['pairs']]
         ordered = sum(p['label'] != '=' for p in chosen)
         n_photos = sum(e['split'] == split for e in merged)
         print(f'{split}: {n_photos} photos, {len(chosen)} labelled pairs, {ordered} ordered')
-    print(f'{ORDINAL_FILE}: {len(labels)} of {len(known)} pairs labelled')
+    multi, same, opposite = agreement(labels)
+    print(f'{ORDINAL_FILE}: {len(labels)} of {len(known)} pairs labelled; {multi} labelled more than once: '
+          f'{same} alike, {opposite} with A against B')
 
 
 def main():
