@@ -267,6 +267,44 @@ def initial_model(args, source, size, resuming: bool):
     return export_depth.unfold_batchnorm(model, batches).train()
 
 
+def training_step(model, optimiser, batch, args):
+    """One Adam step on a batch of TrainingBatches: (loss, its parts, ranking loss)."""
+    rgb, disp, real_rgb, pairs = batch
+    rgb, disp = rgb.to(args.device, non_blocking=True), disp.to(args.device, non_blocking=True)
+    rank = torch.zeros(())
+    if real_rgb is None:
+        loss, parts = losses.depth_loss(model(rgb), disp)
+    else:  # one pass over both: the BatchNorms see real photos too
+        real_rgb = real_rgb.to(args.device, non_blocking=True)
+        pairs = [(points.to(args.device), signs.to(args.device)) for points, signs in pairs]
+        outputs = model(torch.cat([rgb, real_rgb]).contiguous(memory_format=torch.channels_last))
+        loss, parts = losses.depth_loss([o[:len(rgb)] for o in outputs], disp)
+        rank = ordinal_data.ranking_loss(outputs[-1][len(rgb):], pairs)
+        loss = loss + args.rank_weight * rank
+    optimiser.zero_grad(set_to_none=True)
+    loss.backward()
+    optimiser.step()
+    return loss, parts, rank
+
+
+def resume(ckpt_path: Path, model, optimiser, scheduler, args, best_of: str):
+    """(step, best score) of the checkpoint, its state loaded into model, optimiser and
+    scheduler. A slim checkpoint (training/gpu_run.py) has no Adam moments: they start
+    again at its learning rate. A best score of another measure than best_of is dropped."""
+    ckpt = torch.load(ckpt_path, map_location=args.device)
+    if ckpt["model_name"] != args.model:
+        raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
+    model.load_state_dict(ckpt["model"])
+    scheduler.load_state_dict(ckpt["scheduler"])
+    if "optimiser" in ckpt:
+        optimiser.load_state_dict(ckpt["optimiser"])
+    else:
+        for group in optimiser.param_groups:
+            group["lr"] = ckpt["lr"]
+    best = ckpt["best_val"] if ckpt.get("best_of", "val_loss") == best_of else math.inf
+    return ckpt["step"], best, "" if "optimiser" in ckpt else " (slim: Adam restarts)"
+
+
 def train(args):
     torch.set_num_threads(args.threads)
     torch.manual_seed(args.seed)
@@ -279,6 +317,7 @@ def train(args):
         import scenes  # the photo folder
         ordinal_train = ordinal_data.load_split("train", scenes.photo_root(), args.ordinal)
         ordinal_val = ordinal_data.load_split("val", scenes.photo_root(), args.ordinal)
+    best_of = "ordinal_whdr" if ordinal_val else "val_loss"  # what best.pt keeps the lowest of
     ckpt_path = run / "checkpoint.pt"
     model = initial_model(args, source, size, resuming=ckpt_path.exists())
     if size[0] % model.multiple or size[1] % model.multiple:
@@ -289,19 +328,8 @@ def train(args):
         optimiser, factor=0.2, patience=args.patience)
     step, best = 0, math.inf
     if ckpt_path.exists():
-        ckpt = torch.load(ckpt_path, map_location=args.device)
-        if ckpt["model_name"] != args.model:
-            raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
-        model.load_state_dict(ckpt["model"])
-        scheduler.load_state_dict(ckpt["scheduler"])
-        step, best = ckpt["step"], ckpt["best_val"]
-        if "optimiser" in ckpt:
-            optimiser.load_state_dict(ckpt["optimiser"])
-        else:  # a slim checkpoint (training/gpu_run.py): Adam's moments start again
-            for group in optimiser.param_groups:
-                group["lr"] = ckpt["lr"]
-        log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}"
-                      + ("" if "optimiser" in ckpt else " (slim: Adam restarts)"))
+        step, best, note = resume(ckpt_path, model, optimiser, scheduler, args, best_of)
+        log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}{note}")
     elif args.init:
         log_line(run, f"initialised {args.model} from {args.init}")
     val_count = source.validation_count(args.val_count)
@@ -312,28 +340,30 @@ def train(args):
     def checkpoint():
         save_checkpoint(ckpt_path, {
             "model_name": args.model, "model": model.state_dict(), "optimiser": optimiser.state_dict(),
-            "scheduler": scheduler.state_dict(), "step": step, "best_val": best})
+            "scheduler": scheduler.state_dict(), "step": step, "best_val": best, "best_of": best_of})
+
+    def validation():
+        nonlocal best
+        val_loss, metrics = validate(model, source, val_count, args.batch, args.device)
+        scheduler.step(val_loss)
+        whdr = validate_ordinal(model, ordinal_val, size, args.device) if ordinal_val else None
+        score = whdr if whdr is not None else val_loss
+        if score < best:  # the weights worth exporting, kept apart from the latest
+            best = score
+            save_checkpoint(run / "best.pt", {"model_name": args.model, "model": model.state_dict(),
+                                              "step": step, "val_loss": val_loss, "metrics": metrics,
+                                              "ordinal_whdr": whdr})
+        shown = " ".join(f"{name} {value:.4f}" for name, value in metrics.items())
+        if whdr is not None:
+            shown += f" ordinal_whdr {whdr:.4f}"
+        log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
 
     ahead = {"num_workers": args.workers, "worker_init_fn": _worker_init, "prefetch_factor": 4} if args.workers else {}
     batches = torch.utils.data.DataLoader(TrainingBatches(source, args, size, step, ordinal_train),
                                           batch_size=None, shuffle=False, **ahead)
     t0, seen, timed_from = time.time(), 0, None
-    for rgb, disp, real_rgb, pairs in batches:
-        rgb, disp = rgb.to(args.device, non_blocking=True), disp.to(args.device, non_blocking=True)
-        rank = torch.zeros(())
-        if real_rgb is None:
-            loss, parts = losses.depth_loss(model(rgb), disp)
-        else:  # one pass over both: the BatchNorms see real photos too
-            real_rgb = real_rgb.to(args.device, non_blocking=True)
-            pairs = [(points.to(args.device), signs.to(args.device)) for points, signs in pairs]
-            outputs = model(torch.cat([rgb, real_rgb]).contiguous(memory_format=torch.channels_last))
-            n = len(rgb)
-            loss, parts = losses.depth_loss([o[:n] for o in outputs], disp)
-            rank = ordinal_data.ranking_loss(outputs[-1][n:], pairs)
-            loss = loss + args.rank_weight * rank
-        optimiser.zero_grad(set_to_none=True)
-        loss.backward()
-        optimiser.step()
+    for batch in batches:
+        loss, parts, rank = training_step(model, optimiser, batch, args)
         step += 1
         seen += 1
         trained_until = time.time()
@@ -345,19 +375,7 @@ def train(args):
                           f"{(time.time() - t0) / seen:.2f} s/step")
         out_of_time = args.minutes > 0 and time.time() - t0 >= 60 * args.minutes
         if step % args.val_every == 0 or step == args.steps or out_of_time:
-            val_loss, metrics = validate(model, source, val_count, args.batch, args.device)
-            scheduler.step(val_loss)
-            whdr = validate_ordinal(model, ordinal_val, size, args.device) if ordinal_val else None
-            score = whdr if whdr is not None else val_loss  # what best.pt keeps the lowest of
-            if score < best:  # the weights worth exporting, kept apart from the latest
-                best = score
-                save_checkpoint(run / "best.pt", {"model_name": args.model, "model": model.state_dict(),
-                                                  "step": step, "val_loss": val_loss, "metrics": metrics,
-                                                  "ordinal_whdr": whdr})
-            shown = " ".join(f"{name} {value:.4f}" for name, value in metrics.items())
-            if whdr is not None:
-                shown += f" ordinal_whdr {whdr:.4f}"
-            log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
+            validation()
         if step % args.checkpoint_every == 0 or step == args.steps or out_of_time:
             checkpoint()
         if out_of_time:
