@@ -5,6 +5,7 @@ import random
 import sys
 import tempfile
 import unittest
+import unittest.mock
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,8 @@ from PIL import Image
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import ordinal_data  # noqa: E402
+sys.path.insert(0, str(Path(__file__).resolve().parent / "ordinal"))
+import pairs  # noqa: E402
 
 
 def coordinate_photo(w, h):
@@ -82,6 +85,40 @@ class Reading(unittest.TestCase):
             (root / "set.json").write_text(json.dumps({"photos": [entry]}))
             with self.assertRaisesRegex(RuntimeError, "a.png: is \\(100, 80\\), labelled at 120x80"):
                 ordinal_data.load_split("val", root, root / "set.json")
+
+
+class Labelling(unittest.TestCase):
+    def test_pairs_are_drawn_inside_the_photo_the_same_way_every_time(self):
+        with tempfile.TemporaryDirectory() as folder:
+            path = Path(folder) / "p.png"
+            Image.fromarray(coordinate_photo(300, 200)).save(path)
+            with unittest.mock.patch.object(pairs.scenes, "ordinal_split", return_value="train"):
+                first, again = pairs.sample_photo(path, "x/p.png"), pairs.sample_photo(path, "x/p.png")
+        self.assertEqual(first, again)
+        self.assertEqual([p["kind"] for p in first["pairs"]], ["random"] * 5 + ["edge"] * 2)
+        for pair in first["pairs"]:
+            for x, y in (pair["a"], pair["b"]):
+                self.assertTrue(0 <= x < 300 and 0 <= y < 200, pair)
+
+    def test_an_order_is_kept_only_when_every_labeller_gave_it(self):
+        self.assertEqual(pairs.consensus(["A"]), "A")
+        self.assertEqual(pairs.consensus(["B", "B"]), "B")
+        self.assertEqual(pairs.consensus(["A", "="]), "=")
+        self.assertEqual(pairs.consensus(["A", "B"]), "=")
+        votes = {("p", 1): ["A", "A"], ("p", 2): ["A", "B"], ("p", 3): ["=", "B"], ("p", 4): ["A"]}
+        self.assertEqual(pairs.agreement(votes), (3, 1, 1))
+
+    def test_label_files_are_checked_line_by_line(self):
+        with tempfile.TemporaryDirectory() as folder:
+            (Path(folder) / "one.tsv").write_text("p.jpg\t1\tA\np.jpg\t2\t=\n")
+            (Path(folder) / "two.tsv").write_text("p.jpg\t1\tB\n")
+            self.assertEqual(pairs.read_labels(folder), {("p.jpg", 1): ["A", "B"], ("p.jpg", 2): ["="]})
+            (Path(folder) / "two.tsv").write_text("p.jpg\t1\tnearer\n")
+            with self.assertRaisesRegex(SystemExit, "two.tsv:1: expected"):
+                pairs.read_labels(folder)
+            (Path(folder) / "two.tsv").write_text("p.jpg\t1\tA\np.jpg\t1\tB\n")
+            with self.assertRaisesRegex(SystemExit, "two.tsv:2: .* labelled twice in one file"):
+                pairs.read_labels(folder)
 
 
 if __name__ == "__main__":
