@@ -333,7 +333,8 @@ def train(args):
     elif args.init:
         log_line(run, f"initialised {args.model} from {args.init}")
     val_count = source.validation_count(args.val_count)
-    real = f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs)" if ordinal_train else ""
+    real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g})"
+            if ordinal_train else "")
     log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data}{real} "
                   f"at {size[0]}x{size[1]}, batch {args.batch}, {args.threads} threads, {args.workers} workers")
 
