@@ -235,9 +235,11 @@ def main(argv=None):
                         "images generalises to a few times its training size, not to any)")
     args = p.parse_args(argv)
     model, ckpt = load_checkpoint(args.checkpoint)
-    meta = export(model, args.output, {"steps": int(ckpt["step"]), "data": args.data,
-                                       "best_val_loss": float(ckpt.get("best_val", ckpt.get("val_loss")))},
-                  args.working_long_side)
+    provenance = {"steps": int(ckpt["step"]), "data": args.data,
+                  "best_val_loss": float(ckpt.get("best_val", ckpt.get("val_loss")))}
+    if ckpt.get("ordinal_whdr") is not None:  # a best.pt kept by the ordinal validation
+        provenance["ordinal_val_whdr"] = float(ckpt["ordinal_whdr"])
+    meta = export(model, args.output, provenance, args.working_long_side)
     size = Path(args.output).stat().st_size
     print(f"{args.output}: {meta['depth.variant']}, {meta['depth.parameters']} parameters, "
           f"{size / 1e6:.2f} MB, step {ckpt['step']}")
