@@ -41,8 +41,8 @@ MIN_RANDOM_GAP = 0.08    # random pair points at least this share of the diagona
 EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the edge
 EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
-ZOOM = 3
-LABELS = {'A': 1, 'B': -1, '=': 0}   # A nearer, B nearer, too close to call
+ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
+LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
 PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
            (0, 230, 230), (255, 140, 0)]
 
@@ -140,7 +140,7 @@ def mark(draw, xy, shape, colour, text, radius, text_size):
 
 def draw_photo(path, entry):
     """The photo at DISPLAY_LONG_SIDE with every pair marked (A a circle, B a square, one
-    colour per pair), and below it a ZOOM-times crop around each edge pair."""
+    colour per pair), and below it an enlarged crop around each edge pair."""
     photo = load_upright(path)
     scale = DISPLAY_LONG_SIDE / max(photo.size)
     shown = photo.resize((round(photo.width * scale), round(photo.height * scale)), Image.LANCZOS)
@@ -163,18 +163,17 @@ def draw_photo(path, entry):
     return canvas
 
 
-def zoom_crop(photo, pair, half=(80, 50)):
-    """A ZOOM-times enlargement of the photo around one pair, the pair marked again."""
-    scale = ZOOM * DISPLAY_LONG_SIDE / max(photo.size) / 2
+def zoom_crop(photo, pair, size=(480, 300)):
+    """The photo around one pair at ZOOM times the shown size, the pair marked again."""
+    scale = ZOOM * DISPLAY_LONG_SIDE / max(photo.size)   # crop pixels per photo pixel
     centre = [(pair['a'][i] + pair['b'][i]) / 2 for i in range(2)]
-    box = [centre[0] - half[0] / scale, centre[1] - half[1] / scale,
-           centre[0] + half[0] / scale, centre[1] + half[1] / scale]
-    crop = photo.crop([round(v) for v in box]).resize((2 * half[0] * 3, 2 * half[1] * 3), Image.LANCZOS)
-    k = crop.width / (box[2] - box[0])
+    reach = (size[0] / 2 / scale, size[1] / 2 / scale)
+    box = [centre[0] - reach[0], centre[1] - reach[1], centre[0] + reach[0], centre[1] + reach[1]]
+    crop = photo.crop([round(v) for v in box]).resize(size, Image.LANCZOS)
     draw = ImageDraw.Draw(crop)
     colour = PALETTE[(pair['id'] - 1) % len(PALETTE)]
     for key, shape in (('a', 'circle'), ('b', 'square')):
-        xy = [(pair[key][0] - box[0]) * k, (pair[key][1] - box[1]) * k]
+        xy = [(pair[key][0] - box[0]) * scale, (pair[key][1] - box[1]) * scale]
         mark(draw, xy, shape, colour, f"{pair['id']}{key.upper()}", 9, 20)
     return crop
 
