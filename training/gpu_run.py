@@ -8,9 +8,9 @@ other: pack what the run needs here, train there, bring the checkpoint back.
     /usr/bin/python3 training/gpu_run.py unpack FILES_AT --run training/runs/lite-256
 
 The GPU machine gets only the working tree and the carried folder (64 MiB in all), not
-../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the same folder and file names, so the
-train/validation splits are the same there, and the ordinal set with its points scaled to
-those sizes. Scenes are made by DataLoader workers on the machine's cores while the GPU
+../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the
+same folder and file names, so the train/validation splits are the same there, and the
+ordinal set with its points scaled to those sizes. Scenes are made by DataLoader workers on the machine's cores while the GPU
 trains; --minutes stops the run validated and checkpointed inside the command's limit.
 Checkpoints cross slim (no Adam moments: the repository's tracked files already take
 about 44 of the 64 MiB): the run resumes with its weights, step, schedule and learning
@@ -35,7 +35,6 @@ ROOT = Path(__file__).resolve().parents[1]
 PHOTO_LONG_SIDE = 384
 TRANSFER_LIMIT = 64 * 2 ** 20   # the device tool's working tree, carried folder included
 ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
-
 
 
 def slim_checkpoint(source: Path, target: Path):
