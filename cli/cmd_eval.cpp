@@ -223,6 +223,11 @@ void print_depth_row(const std::string& method, const DepthMetrics& m, int image
               m.rel, images);
 }
 
+// --weights FILE, or the bundled file of --model.
+DepthNet load_depth_net(const DepthEvalArgs& a) {
+  return DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+}
+
 void print_ordinal_row(const std::string& method, const OrdinalScore& s, int photos) {
   std::printf("%-20s %8.4f %7d %7d\n", method.c_str(), s.whdr(), s.pairs, photos);
 }
@@ -239,7 +244,7 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
   for (const OrdinalPhoto& e : set)  // a missing photo stops before the network runs
     if (!fs::is_regular_file(fs::path(a.images) / e.photo))
       throw std::runtime_error((fs::path(a.images) / e.photo).string() + ": photo of the ordinal set not found");
-  DepthNet net = DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+  DepthNet net = load_depth_net(a);
   const int side = a.working_size ? a.working_size : net.working_long_side();
   OrdinalScore network, gradient, constant;
   for (const OrdinalPhoto& e : set) {
@@ -296,7 +301,7 @@ int eval_depth(int argc, char** argv) {
   // Every reference is looked up before the network runs: a missing one stops at once.
   std::vector<std::string> references;
   for (const std::string& photo : photos) references.push_back(find_depth_reference(photo, a.images, a.reference));
-  DepthNet net = DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+  DepthNet net = load_depth_net(a);
   const int side = a.working_size ? a.working_size : net.working_long_side();
   DepthMetricsMean network, gradient;
   for (size_t i = 0; i < photos.size(); ++i) {

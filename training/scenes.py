@@ -66,25 +66,26 @@ def _photo_names(folder):
     return tuple(sorted(p.name for p in entries if p.suffix.lower() in PHOTO_SUFFIXES))
 
 
-def photo_split(path):
-    """'val' for every tenth photo of its folder by sorted name, else 'train'."""
+def _every_nth_of_folder(path, period):
+    """True for every period-th photo of its folder by sorted name (indices period - 1,
+    2 period - 1, ...)."""
     path = Path(path)
     names = _photo_names(str(path.resolve().parent))
     if path.name not in names:
         raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
-    return 'val' if names.index(path.name) % VALIDATION_PHOTO_PERIOD == VALIDATION_PHOTO_PERIOD - 1 else 'train'
+    return names.index(path.name) % period == period - 1
+
+
+def photo_split(path):
+    """'val' for every tenth photo of its folder by sorted name, else 'train'."""
+    return 'val' if _every_nth_of_folder(path, VALIDATION_PHOTO_PERIOD) else 'train'
 
 
 def ordinal_split(path):
     """'val' for every fifth photo of its folder by sorted name (the synthetic validation
     photos and as many more), else 'train'. Ordinal validation photos are never trained on:
     not ranked, and not textures of training scenes either."""
-    path = Path(path)
-    names = _photo_names(str(path.resolve().parent))
-    if path.name not in names:
-        raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
-    period = ORDINAL_VALIDATION_PERIOD
-    return 'val' if names.index(path.name) % period == period - 1 else 'train'
+    return 'val' if _every_nth_of_folder(path, ORDINAL_VALIDATION_PERIOD) else 'train'
 
 
 def photo_root():
