@@ -15,6 +15,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "cli/eval_common.h"
 #include "engine/thread_pool.h"
 #include "eval/depth_eval.h"
 #include "eval/ordinal_eval.h"
@@ -65,20 +66,6 @@ struct InpaintEvalArgs {
   double radius = 5;
 };
 
-std::vector<std::string> list_images(const std::string& dir) {
-  if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a directory");
-  std::vector<std::string> found;
-  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
-    if (!entry.is_regular_file()) continue;
-    std::string ext = entry.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-    if (ext == ".jpg" || ext == ".jpeg" || ext == ".png") found.push_back(entry.path().string());
-  }
-  if (found.empty()) throw std::runtime_error(dir + ": no .jpg, .jpeg or .png photos");
-  std::sort(found.begin(), found.end());
-  return found;
-}
-
 // The depth network is required: without it there are no planes to evaluate on.
 DepthNet load_depth(const std::string& path) {
   std::string file = path;
@@ -101,14 +88,6 @@ DepthNet load_depth(const std::string& path) {
 // The map of images/sub/photo.jpg is depth_dir/sub/photo.jpg.png.
 std::string depth_map_path(const std::string& depth_dir, const std::string& images, const std::string& photo) {
   return (fs::path(depth_dir) / fs::path(photo).lexically_relative(images)).string() + ".png";
-}
-
-cv::Mat fit_long_side(const cv::Mat& bgr, int max_side) {
-  const double scale = double(max_side) / std::max(bgr.cols, bgr.rows);
-  if (scale >= 1) return bgr;
-  cv::Mat out;
-  cv::resize(bgr, out, {}, scale, scale, cv::INTER_AREA);
-  return out;
 }
 
 MarginFiller network_filler(std::shared_ptr<const InpaintNet> net) {
@@ -503,6 +482,7 @@ const Mode kModes[] = {
     {"depth", eval_depth, "depth metrics (delta, RMSE, REL) against reference maps, or WHDR on an ordinal set"},
     {"slicing", eval_slicing, "the paper's Table 3: adaptive vs. uniform MPIs against a dense one (SSIM, PSNR)"},
     {"inpaint", eval_inpaint, "margin filling: ampi vs. cv::inpaint Telea / Navier-Stokes, push-pull, harmonic"},
+    {"edges", eval_edges, "objects kept whole in new views: wrong object pixels and fringe at depth edges"},
 };
 
 void usage(FILE* out) {

@@ -59,7 +59,11 @@ const char kUsage[] =
     "                          paper's rule exactly)\n"
     "  --tear-penalty P        optimal slicer: a cut also costs P squared levels per pixel of the\n"
     "                          edge-free depth histogram at the cut (default 0)\n"
-    "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0)\n"
+    "  --soft-alpha L          alpha ramp L disparity levels wide across plane cuts (default 0;\n"
+    "                          > 0 keeps the snapped depth edges but not their feathered borders)\n"
+    "  --no-edge-snap          slice the depth map's soft edges as they are (the paper), instead\n"
+    "                          of snapping them to the photo's colour edges and cleaning the\n"
+    "                          layers' borders there (ampi eval edges compares the two)\n"
     "  --inpainter NAME        what fills occluded margins: network (default), harmonic (as close\n"
     "                          to the truth, no texture, faster) or push-pull (fastest)\n"
     "  --inpaint-weights FILE  inpainting network weight file (implies --inpainter network)\n"
@@ -112,6 +116,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.option("--min-plane-share", &a.mpi.slicing.min_plane_share, 0.0, 1.0);
   p.option("--tear-penalty", &a.mpi.slicing.tear_penalty, 0.0, 1e9);
   p.option("--soft-alpha", &a.mpi.soft_alpha, 0, 64);
+  p.flag("--no-edge-snap", [&] { a.mpi.snap_depth_edges = false; });
   p.option("--inpaint-weights", &a.mpi.inpaint_weights);
   p.option("--inpainter", [&](const std::string& v) { a.mpi.inpainter = parse_inpainter(v); });
   p.option("--fov", &a.mpi.fov_degrees, 1, 179);

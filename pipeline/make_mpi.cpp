@@ -98,30 +98,56 @@ MpiResult MpiMaker::make(const cv::Mat& photo, const std::string& photo_path, Pr
                    std::to_string(layers) + " RGBA layers at " + std::to_string(bgr.cols) + "x" +
                        std::to_string(bgr.rows));
   const cv::Mat disparity = working_disparity(bgr, photo.size(), photo_path, progress);
-  // Slice at the working resolution (the histogram needs no more pixels), cut the
-  // layers at the photo's own resolution.
-  std::vector<Plane> planes = progress.stage("slicing", [&] {
-    cv::Mat small = disparity;
-    const ImageSize work = depth_working_size(disparity.rows, disparity.cols,
-                                              options_.working_size ? options_.working_size : 1024);
-    if (work.width != disparity.cols || work.height != disparity.rows)
-      cv::resize(disparity, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
-    result.slicing_size = small.size();
-    return options_.uniform
-               ? slice_uniform(small, options_.slicing.max_planes, options_.slicing.range)
-               : slice_adaptive(small, options_.slicing);
-  });
-  result.mpi = progress.stage("assembly", [&] {
-    if (disparity.size() == bgr.size())
-      result.disparity = disparity;
-    else
-      cv::resize(disparity, result.disparity, bgr.size(), 0, 0, cv::INTER_LINEAR);
-    const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
-    return assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range,
-                        options_.soft_alpha);
-  });
+  MpiResult made = make_from_disparity(bgr, disparity, progress);
+  made.full_bgr = result.full_bgr;
+  made.full_camera = result.full_camera;
+  return made;
+}
+
+// Slice at the working resolution (the histogram needs no more pixels): the size of the
+// map depth gave (the network's working size), at most 1024 px or --working-size.
+std::vector<Plane> MpiMaker::slice(const cv::Mat& disparity, cv::Size depth_size, MpiResult& result) const {
+  cv::Mat small = disparity;
+  const ImageSize work = depth_working_size(depth_size.height, depth_size.width,
+                                            options_.working_size ? options_.working_size : 1024);
+  if (work.width != disparity.cols || work.height != disparity.rows)
+    cv::resize(disparity, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+  result.slicing_size = small.size();
+  return options_.uniform ? slice_uniform(small, options_.slicing.max_planes, options_.slicing.range)
+                          : slice_adaptive(small, options_.slicing);
+}
+
+MpiResult MpiMaker::make_from_disparity(const cv::Mat& bgr, const cv::Mat& disparity, Progress& progress) {
+  MpiResult result;
+  if (!options_.snap_depth_edges) {
+    // The paper's way: slice the map as the network made it, cut the layers from it
+    // enlarged bilinearly.
+    std::vector<Plane> planes = progress.stage("slicing", [&] { return slice(disparity, disparity.size(), result); });
+    result.mpi = progress.stage("assembly", [&] {
+      result.disparity = enlarge_disparity(disparity, bgr.size());
+      const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
+      return assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range, options_.soft_alpha);
+    });
+  } else {
+    const DepthEdges edges =
+        progress.stage("depth edges", [&] { return snap_depth_edges(bgr, disparity, options_.depth_edges); });
+    result.disparity = edges.disparity;
+    std::vector<Plane> planes = progress.stage("slicing", [&] { return slice(result.disparity, disparity.size(), result); });
+    result.mpi = progress.stage("assembly", [&] {
+      const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
+      Mpi mpi = assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range, options_.soft_alpha);
+      if (options_.soft_alpha == 0) feather_depth_edges(mpi, bgr, edges.band, options_.edge_feather);
+      return mpi;
+    });
+  }
   LayerFiller& fill = filler();
-  progress.stage("inpainting", [&] { return inpaint_mpi(result.mpi, fill, margin_for(bgr.size())); });
+  OcclusionMaskParams margin = margin_for(bgr.size());
+  // Feathering took the border pixels from the farther layers: the margin starts that
+  // much nearer their remaining pixels.
+  if (options_.snap_depth_edges && options_.soft_alpha == 0) margin.dilate_iterations += options_.edge_feather;
+  progress.stage("inpainting", [&] {
+    return inpaint_mpi(result.mpi, fill, margin, options_.keep_fill_masks ? &result.fill_masks : nullptr);
+  });
   result.inpainter = inpainter_;
   return result;
 }

@@ -11,6 +11,7 @@
 #include "nets/depth_net.h"
 #include "pipeline/progress.h"
 #include "slicing/adaptive.h"
+#include "slicing/depth_edges.h"
 
 namespace ampi {
 
@@ -25,6 +26,14 @@ struct MpiOptions {
   bool uniform = false;              // the paper's baseline instead of adaptive slicing
   SlicingParams slicing;             // max_planes, the paper's constants, depth range
   double soft_alpha = 0;             // alpha ramp across plane cuts (0 = the paper)
+  // Depth edges that follow the photo (slicing/depth_edges.h): the map's soft ramps
+  // become steps on the photo's colour edges before slicing, and the layers' borders at
+  // those edges are cleaned (feather_depth_edges, edge_feather pixels wide). Off: the map
+  // is enlarged bilinearly and sliced as it is, as the paper does.
+  bool snap_depth_edges = true;
+  DepthEdgeParams depth_edges;
+  int edge_feather = 2;
+  bool keep_fill_masks = false;      // MpiResult::fill_masks (for evaluations)
   // Which filler invents the occluded margins. The network by default: on held-out photos
   // it scores above Telea and Navier-Stokes (training/INPAINT.md). The harmonic fill alone
   // scores the same PSNR (the network adds texture); push-pull is the fastest.
@@ -47,6 +56,7 @@ struct MpiResult {
   cv::Mat disparity;  // CV_32FC1 at the MPI's size, larger = nearer
   Mpi mpi;            // inpainted; at the photo's size unless the photo was reduced
   std::string inpainter;  // which filler ran: inpainter_name
+  std::vector<cv::Mat> fill_masks;  // with keep_fill_masks: per layer, the pixels inpainting invented
   cv::Size slicing_size;  // the map the slicer ran on (the depth network's working size)
   // Set only when the photo was larger than max_working_side: the photo itself and its
   // camera, from which full_resolution.h makes the written layers.
@@ -64,9 +74,16 @@ class MpiMaker {
   // bgr: the decoded photo (pipeline/photo_io.h). `photo_path` names it in errors.
   MpiResult make(const cv::Mat& bgr, const std::string& photo_path, Progress& progress);
 
+  // The stages after depth, from a disparity map of the photo's size or smaller (the
+  // depth network's working size): depth edges, slicing, assembly, inpainting. bgr is
+  // the photo at the MPI's size (no reduction here); the evaluations call this with
+  // disparity maps of their own.
+  MpiResult make_from_disparity(const cv::Mat& bgr, const cv::Mat& disparity, Progress& progress);
+
  private:
   cv::Mat working_disparity(const cv::Mat& bgr, cv::Size photo_size, const std::string& photo_path,
                             Progress& progress);
+  std::vector<Plane> slice(const cv::Mat& disparity, cv::Size depth_size, MpiResult& result) const;
   LayerFiller& filler();
 
   MpiOptions options_;

@@ -1,6 +1,8 @@
 #include "slicing/assemble.h"
 
 #include <algorithm>
+#include <cmath>
+#include <opencv2/imgproc.hpp>
 #include <stdexcept>
 #include <string>
 
@@ -95,6 +97,52 @@ Mpi assemble_mpi(const cv::Mat& bgr, const cv::Mat& disparity, const std::vector
   mpi.layers = soft_alpha > 0 ? soft_layers(bgr, disparity, planes, soft_alpha)
                               : hard_layers(bgr, disparity, planes);
   return mpi;
+}
+
+namespace {
+
+// Per pixel: 1 + the index of the layer that holds it (layers are back to front, so a
+// larger owner is nearer), 0 where no layer does.
+cv::Mat layer_owners(const Mpi& mpi) {
+  cv::Mat owner(mpi.layers[0].size(), CV_8UC1, cv::Scalar(0));
+  for (size_t j = 0; j < mpi.layers.size(); ++j) {
+    cv::Mat alpha;
+    cv::extractChannel(mpi.layers[j], alpha, 3);
+    owner.setTo(cv::Scalar(double(j + 1)), alpha > 0);
+  }
+  return owner;
+}
+
+}  // namespace
+
+int64_t feather_depth_edges(Mpi& mpi, const cv::Mat& bgr, const cv::Mat& band, int width) {
+  if (mpi.layers.empty() || width <= 0) return 0;
+  if (mpi.layers.size() > 254) throw std::invalid_argument("feather_depth_edges: more than 254 layers");
+  const cv::Size size = mpi.layers[0].size();
+  if (bgr.size() != size || bgr.type() != CV_8UC3 || band.size() != size || band.type() != CV_8UC1)
+    throw std::invalid_argument("feather_depth_edges: the photo and the band must be of the layers' size");
+  const cv::Mat owner = layer_owners(mpi);
+  // Dilating the owners spreads the nearer layers outwards one pixel per step: after r
+  // steps a pixel holds the nearest layer within chessboard distance r.
+  cv::Mat reach = owner.clone(), moved(size, CV_8UC1, cv::Scalar(0));
+  int64_t count = 0;
+  for (int r = 1; r <= width; ++r) {
+    cv::dilate(reach, reach, cv::Mat());
+    const uchar alpha = static_cast<uchar>(std::lround(255.0 * (width + 1 - r) / (width + 1)));
+    for (int y = 0; y < size.height; ++y) {
+      const uchar *own = owner.ptr<uchar>(y), *near = reach.ptr<uchar>(y), *edge = band.ptr<uchar>(y);
+      uchar* done = moved.ptr<uchar>(y);
+      const cv::Vec3b* colour = bgr.ptr<cv::Vec3b>(y);
+      for (int x = 0; x < size.width; ++x) {
+        if (!edge[x] || done[x] || own[x] == 0 || near[x] <= own[x]) continue;
+        mpi.layers[own[x] - 1].ptr<cv::Vec4b>(y)[x] = {0, 0, 0, 0};
+        mpi.layers[near[x] - 1].ptr<cv::Vec4b>(y)[x] = {colour[x][0], colour[x][1], colour[x][2], alpha};
+        done[x] = 255;
+        ++count;
+      }
+    }
+  }
+  return count;
 }
 
 }  // namespace ampi

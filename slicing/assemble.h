@@ -24,4 +24,17 @@ namespace ampi {
 Mpi assemble_mpi(const cv::Mat& bgr, const cv::Mat& disparity, const std::vector<Plane>& planes,
                  const Camera& cam, const DepthRange& range, double soft_alpha = 0);
 
+// Clean layer borders at depth edges, for hard layers (soft_alpha 0) of the map that
+// snap_depth_edges made: a pixel of the edge band (its `band`, CV_8UC1 of the photo's
+// size, 255 near a depth edge) that lies within `width` pixels (chessboard distance r)
+// of a nearer layer's pixel leaves its own layer and joins the nearest such layer with
+// the photo's colour and alpha 255 (width + 1 - r) / (width + 1). So the nearer layer
+// keeps its whole object with a thin alpha ramp against aliasing, and the farther layer
+// loses the border pixels the object's colour may have bled into: they are now hidden
+// by the nearer layer, so the inpainter fills them from the farther layer's own pixels
+// and no foreground colour is smeared into the background's margin. The photo is
+// reproduced in the source view up to that ramp over the filled background.
+// Returns the number of pixels moved.
+int64_t feather_depth_edges(Mpi& mpi, const cv::Mat& bgr, const cv::Mat& band, int width);
+
 }  // namespace ampi

@@ -1,6 +1,7 @@
-// Row kernels of the slicer: the normalisation of a disparity map to levels and the
-// bilateral filter on those levels. Pure functions (single-threaded, no allocation);
-// slicing/level_stats.cpp and slicing/bilateral.cpp walk the rows and call one per row.
+// Row kernels of the slicer: the normalisation of a disparity map to levels, the
+// bilateral filter on those levels, and the snapping of depth edges to the photo's
+// colour edges. Pure functions (single-threaded, no allocation); slicing/level_stats.cpp,
+// slicing/bilateral.cpp and slicing/depth_edges.cpp walk the rows and call one per row.
 //
 // normalize_row is the same computation in every variant (double precision, a
 // subtraction then a product, no fused operations), so all variants agree bit for bit.
@@ -66,12 +67,38 @@ using RangeRowFn = void (*)(const float* in, int n, ValueRange& range);
 using NormalizeRowFn = void (*)(const float* in, int n, double lo, double scale, float* value,
                                 uint8_t* level);
 
+// One row of depth-edge snapping (slicing/depth_edges.h), every input a row of n floats
+// at the photo's resolution: the disparity, the photo's blue, green and red (0..255),
+// the colour-guided fit of the disparity (g = a0 B + a1 G + a2 R + b) and the local
+// extremes of the disparity (lo, hi). For x in [0, n):
+//   band[x] = hi - lo >= min_step ? 255 : 0   (a depth edge is near)
+//   a pixel of the band strictly inside the ramp, lo + margin (hi - lo) < d < hi -
+//   margin (hi - lo), takes the side its colour fits: out = g >= (lo + hi) / 2 ? hi : lo;
+//   every other pixel keeps its disparity: out = d.
+// g is fma(a2, R, fma(a1, G, fma(a0, B, b))) in float in every variant, so all agree bit
+// for bit.
+struct SnapRowInputs {
+  const float* disparity;
+  const float* blue;
+  const float* green;
+  const float* red;
+  const float* a0;
+  const float* a1;
+  const float* a2;
+  const float* b;
+  const float* lo;
+  const float* hi;
+};
+using SnapRowFn = void (*)(const SnapRowInputs& in, int n, float min_step, float margin, float* out,
+                           uint8_t* band);
+
 struct SlicingKernels {
   Isa isa = Isa::Scalar;
   RangeRowFn range_row = nullptr;
   NormalizeRowFn normalize_row = nullptr;
   BilateralWeightsFn bilateral_weights = nullptr;
   BilateralCombineFn bilateral_combine = nullptr;
+  SnapRowFn snap_row = nullptr;
 };
 
 // The variant for an instruction set; throws std::runtime_error if this build or CPU
@@ -83,7 +110,8 @@ SlicingKernels slicing_kernels(Isa isa);
   void normalize_row(const float* in, int n, double lo, double scale, float* value,           \
                      uint8_t* level);                                                         \
   void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight); \
-  void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out);
+  void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out); \
+  void snap_row(const SnapRowInputs& in, int n, float min_step, float margin, float* out, uint8_t* band);
 
 namespace scalar {
 AMPI_SLICING_ROW_KERNELS

@@ -125,4 +125,28 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
   }
 }
 
+void snap_row(const SnapRowInputs& in, int n, float min_step, float margin, float* out, uint8_t* band) {
+  const __m256 step = _mm256_set1_ps(min_step), m = _mm256_set1_ps(margin), neg_m = _mm256_set1_ps(-margin);
+  const __m256 half = _mm256_set1_ps(0.5f);
+  int x = 0;
+  for (; x + 8 <= n; x += 8) {
+    const __m256 lo = _mm256_loadu_ps(in.lo + x), hi = _mm256_loadu_ps(in.hi + x);
+    const __m256 d = _mm256_loadu_ps(in.disparity + x);
+    const __m256 spread = _mm256_sub_ps(hi, lo);
+    const __m256 edge = _mm256_cmp_ps(spread, step, _CMP_GE_OQ);
+    const __m256 inside = _mm256_and_ps(_mm256_cmp_ps(d, _mm256_fmadd_ps(m, spread, lo), _CMP_GT_OQ),
+                                        _mm256_cmp_ps(d, _mm256_fmadd_ps(neg_m, spread, hi), _CMP_LT_OQ));
+    __m256 fit = _mm256_fmadd_ps(_mm256_loadu_ps(in.a0 + x), _mm256_loadu_ps(in.blue + x), _mm256_add_ps(_mm256_loadu_ps(in.b + x), d));
+    fit = _mm256_fmadd_ps(_mm256_loadu_ps(in.a1 + x), _mm256_loadu_ps(in.green + x), fit);
+    fit = _mm256_fmadd_ps(_mm256_loadu_ps(in.a2 + x), _mm256_loadu_ps(in.red + x), fit);
+    const __m256 near = _mm256_cmp_ps(fit, _mm256_mul_ps(_mm256_add_ps(lo, hi), half), _CMP_GE_OQ);
+    const __m256 side = _mm256_blendv_ps(lo, hi, near);
+    _mm256_storeu_ps(out + x, _mm256_blendv_ps(d, side, _mm256_and_ps(edge, inside)));
+    store8_bytes(_mm256_and_si256(_mm256_castps_si256(edge), _mm256_set1_epi32(255)), band + x);
+  }
+  scalar::snap_row({in.disparity + x, in.blue + x, in.green + x, in.red + x, in.a0 + x, in.a1 + x, in.a2 + x,
+                    in.b + x, in.lo + x, in.hi + x},
+                   n - x, min_step, margin, out + x, band + x);
+}
+
 }  // namespace ampi::slicing::avx2

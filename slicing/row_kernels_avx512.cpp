@@ -88,4 +88,25 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
   }
 }
 
+void snap_row(const SnapRowInputs& in, int n, float min_step, float margin, float* out, uint8_t* band) {
+  const __m512 step = _mm512_set1_ps(min_step), m = _mm512_set1_ps(margin), neg_m = _mm512_set1_ps(-margin);
+  const __m512 half = _mm512_set1_ps(0.5f);
+  for (int x = 0; x < n; x += 16) {
+    const __mmask16 lanes = lanes_left(n - x);
+    auto load = [&](const float* p) { return _mm512_maskz_loadu_ps(lanes, p + x); };  // zeros past the row
+    const __m512 lo = load(in.lo), hi = load(in.hi), d = load(in.disparity);
+    const __m512 spread = _mm512_sub_ps(hi, lo);
+    const __mmask16 edge = _mm512_cmp_ps_mask(spread, step, _CMP_GE_OQ);
+    const __mmask16 inside = _mm512_cmp_ps_mask(d, _mm512_fmadd_ps(m, spread, lo), _CMP_GT_OQ) &
+                             _mm512_cmp_ps_mask(d, _mm512_fmadd_ps(neg_m, spread, hi), _CMP_LT_OQ);
+    __m512 fit = _mm512_fmadd_ps(load(in.a0), load(in.blue), _mm512_add_ps(load(in.b), d));
+    fit = _mm512_fmadd_ps(load(in.a1), load(in.green), fit);
+    fit = _mm512_fmadd_ps(load(in.a2), load(in.red), fit);
+    const __mmask16 near = _mm512_cmp_ps_mask(fit, _mm512_mul_ps(_mm512_add_ps(lo, hi), half), _CMP_GE_OQ);
+    const __m512 side = _mm512_mask_blend_ps(near, lo, hi);
+    _mm512_mask_storeu_ps(out + x, lanes, _mm512_mask_blend_ps(edge & inside, d, side));
+    _mm_mask_storeu_epi8(band + x, lanes, _mm_maskz_set1_epi8(edge, static_cast<char>(255)));
+  }
+}
+
 }  // namespace ampi::slicing::avx512

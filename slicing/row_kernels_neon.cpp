@@ -123,4 +123,29 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
   }
 }
 
+void snap_row(const SnapRowInputs& in, int n, float min_step, float margin, float* out, uint8_t* band) {
+  const float32x4_t step = vdupq_n_f32(min_step), m = vdupq_n_f32(margin), neg_m = vdupq_n_f32(-margin);
+  int x = 0;
+  for (; x + 4 <= n; x += 4) {
+    const float32x4_t lo = vld1q_f32(in.lo + x), hi = vld1q_f32(in.hi + x), d = vld1q_f32(in.disparity + x);
+    const float32x4_t spread = vsubq_f32(hi, lo);
+    const uint32x4_t edge = vcgeq_f32(spread, step);
+    // vfmaq_f32(c, a, b) = c + a * b, fused.
+    const uint32x4_t inside = vandq_u32(vcgtq_f32(d, vfmaq_f32(lo, m, spread)), vcltq_f32(d, vfmaq_f32(hi, neg_m, spread)));
+    float32x4_t fit = vfmaq_f32(vaddq_f32(vld1q_f32(in.b + x), d), vld1q_f32(in.a0 + x), vld1q_f32(in.blue + x));
+    fit = vfmaq_f32(fit, vld1q_f32(in.a1 + x), vld1q_f32(in.green + x));
+    fit = vfmaq_f32(fit, vld1q_f32(in.a2 + x), vld1q_f32(in.red + x));
+    const uint32x4_t near = vcgeq_f32(fit, vmulq_f32(vaddq_f32(lo, hi), vdupq_n_f32(0.5f)));
+    const float32x4_t side = vbslq_f32(near, hi, lo);
+    vst1q_f32(out + x, vbslq_f32(vandq_u32(edge, inside), side, d));
+    const uint16x4_t narrow = vmovn_u32(vandq_u32(edge, vdupq_n_u32(255)));
+    uint8_t bytes[8];
+    vst1_u8(bytes, vmovn_u16(vcombine_u16(narrow, narrow)));
+    std::memcpy(band + x, bytes, 4);
+  }
+  scalar::snap_row({in.disparity + x, in.blue + x, in.green + x, in.red + x, in.a0 + x, in.a1 + x, in.a2 + x,
+                    in.b + x, in.lo + x, in.hi + x},
+                   n - x, min_step, margin, out + x, band + x);
+}
+
 }  // namespace ampi::slicing::neon

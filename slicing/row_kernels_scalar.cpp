@@ -41,4 +41,18 @@ void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, 
   }
 }
 
+void snap_row(const SnapRowInputs& in, int n, float min_step, float margin, float* out, uint8_t* band) {
+  for (int x = 0; x < n; ++x) {
+    const float lo = in.lo[x], hi = in.hi[x], d = in.disparity[x];
+    const float spread = hi - lo;
+    const bool edge = spread >= min_step;
+    // Explicit fused multiply-adds: the vector variants use the same, so no compiler's
+    // contraction choice can make them differ.
+    const bool inside = d > std::fma(margin, spread, lo) && d < std::fma(-margin, spread, hi);
+    const float fit = std::fma(in.a2[x], in.red[x], std::fma(in.a1[x], in.green[x], std::fma(in.a0[x], in.blue[x], in.b[x] + d)));
+    out[x] = edge && inside ? (fit >= (lo + hi) * 0.5f ? hi : lo) : d;
+    band[x] = edge ? 255 : 0;
+  }
+}
+
 }  // namespace ampi::slicing::scalar

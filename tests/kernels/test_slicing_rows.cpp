@@ -166,3 +166,40 @@ TEST_CASE("every bilateral combine variant matches the reference within one leve
     CHECK(differing * 100 <= pixels);
   }
 }
+
+TEST_CASE("every snap_row variant equals the scalar reference bit for bit") {
+  std::mt19937 rng(41);
+  std::uniform_real_distribution<float> unit(0.0f, 1.0f), colour(0.0f, 255.0f), coeff(-0.02f, 0.02f);
+  for (Isa isa : runnable_isas()) {
+    const slicing::SnapRowFn snap_row = slicing::slicing_kernels(isa).snap_row;
+    for (int n : {1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 100})
+      for (float margin : {0.0f, 0.1f}) {
+        std::vector<float> lo(n), hi(n), d(n), blue(n), green(n), red(n), a0(n), a1(n), a2(n), b(n);
+        for (int x = 0; x < n; ++x) {
+          lo[x] = unit(rng);
+          hi[x] = lo[x] + (x % 5 == 0 ? 0.05f : unit(rng));  // some spreads below min_step
+          // Inside the ramp, at either extreme, and exactly at the middle.
+          const int kind = x % 4;
+          d[x] = kind == 0 ? lo[x] : kind == 1 ? hi[x] : kind == 2 ? 0.5f * (lo[x] + hi[x]) : lo[x] + unit(rng) * (hi[x] - lo[x]);
+          blue[x] = colour(rng), green[x] = colour(rng), red[x] = colour(rng);
+          a0[x] = coeff(rng), a1[x] = coeff(rng), a2[x] = coeff(rng), b[x] = unit(rng) - 0.5f;
+        }
+        const slicing::SnapRowInputs in{d.data(), blue.data(), green.data(), red.data(), a0.data(),
+                                        a1.data(), a2.data(), b.data(), lo.data(), hi.data()};
+        std::vector<float> want(n), got(n);
+        std::vector<uint8_t> want_band(n), got_band(n);
+        slicing::scalar::snap_row(in, n, 0.1f, margin, want.data(), want_band.data());
+        snap_row(in, n, 0.1f, margin, got.data(), got_band.data());
+        INFO(isa_name(isa) << " n " << n << " margin " << margin);
+        REQUIRE(got == want);
+        REQUIRE(got_band == want_band);
+        for (int x = 0; x < n; ++x) {
+          const bool edge = hi[x] - lo[x] >= 0.1f;
+          CHECK(want_band[x] == (edge ? 255 : 0));
+          // Snapped values are one of the extremes; the rest are untouched.
+          CHECK((want[x] == d[x] || want[x] == lo[x] || want[x] == hi[x]));
+          if (!edge) CHECK(want[x] == d[x]);
+        }
+      }
+  }
+}
