@@ -1,5 +1,5 @@
 #!/bin/sh
-# ampi eval depth and ampi eval slicing through the program, on tiny folders made here.
+# ampi eval depth, slicing and edges through the program, on tiny folders made here.
 # A reference written by `ampi depth` with the same network is the network's own
 # prediction: eval depth must score it delta = 1 and an RMSE of 16-bit rounding only,
 # while the vertical-gradient baseline scores less. Missing and NaN references, bad
@@ -127,6 +127,25 @@ if "$ampi" eval slicing --images "$tmp/images" --counts 2,4 --reference-planes 1
 else
   fail "eval slicing: exit status $?: $(cat "$tmp/err")"
 fi
+
+# Objects kept whole: one row per scene, softness and pose, before/after columns, the
+# target line; and with -o the strips of views.
+if "$ampi" eval edges --softness 4 --pose 0.08,0,0 --inpainter push-pull -o "$tmp/edges" \
+    --threads 2 >"$tmp/out" 2>"$tmp/err"; then
+  rows=$(awk '$2 == "1/4"' "$tmp/out" | wc -l)
+  [ "$rows" -eq 4 ] || fail "eval edges: $rows rows, expected 4: $(cat "$tmp/out")"
+  grep -q "^poses moving an object 40 px or more: 4;" "$tmp/out" || fail "eval edges: poses not judged"
+  grep -q "^target (at most 3% wrong, no fringe): met$" "$tmp/out" || fail "eval edges: target not met"
+  [ -f "$tmp/edges/disk_soft4.png" ] || fail "eval edges: no disk_soft4.png in -o"
+  [ "$rows" -eq 4 ] && echo "ok: eval edges -> $(tail -2 "$tmp/out" | tr '\n' ' ')"
+else
+  fail "eval edges: exit status $?: $(cat "$tmp/err")"
+fi
+expect_error "edges, bad size" "--size: '10x10'" edges --size 10x10
+expect_error "edges, bad softness" "--softness: '0'" edges --softness 1,0
+expect_error "edges, bad pose" "--pose: '1,2'" edges --pose 1,2
+expect_error "edges, missing texture" "$tmp/none.jpg" edges --texture "$tmp/none.jpg"
+expect_error "edges, photos without maps" "--images needs --depth-dir" edges --images "$tmp/images"
 
 [ "$failures" -eq 0 ] || { echo "$failures failure(s)" >&2; exit 1; }
 echo "all eval CLI checks passed"
