@@ -37,11 +37,12 @@ const char kUsage[] =
     "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
     "                           [--inpainter network|harmonic|push-pull] [--working-size N] [--out FILE]\n"
     "\n"
-    "Times every stage of `ampi run` (decode, depth, slicing, assembly, inpainting, MPI\n"
-    "write, render + encode of the video) on PHOTO resized to 1024x768 and to 3840x2160,\n"
-    "medians of N runs, and each stage's peak resident memory. Also slicing's time as a\n"
-    "share of the depth network's (both run at the same working resolution). Writes the\n"
-    "table to bench/RESULTS-pipeline.md.\n"
+    "Times every stage of `ampi run` (decode, depth, depth edges, slicing, assembly,\n"
+    "inpainting, MPI write, render + encode of the video) on PHOTO resized to 1024x768 and\n"
+    "to 3840x2160, medians of N runs, and each stage's peak resident memory. Also slicing's\n"
+    "time as a share of the depth network's (both run at the same working resolution), and\n"
+    "photo to MPI with and without depth edges, run by run. Writes the table to\n"
+    "bench/RESULTS-pipeline.md.\n"
     "\n"
     "  --photo FILE   default examples/forest_path.jpg\n"
     "  --runs N       runs per size (default 3)\n"
@@ -61,7 +62,30 @@ struct SizeResult {
   cv::Size slicing_size;  // where the depth network's output was sliced
   // The network alone and the slicer, timed alternately and warm (measure_slicing_share).
   double warm_network_ms = 0, warm_slicing_ms = 0;
+  // Photo to MPI per run, and the same with --no-edge-snap in a run right after each.
+  std::vector<double> to_mpi_ms, to_mpi_plain_ms;
 };
+
+// The stages from the photo file to the inpainted MPI.
+const char* const kToMpi[] = {"decode", "reduce", "depth", "depth edges", "slicing", "assembly", "inpainting"};
+
+double to_mpi_sum(const Progress& progress) {
+  double sum = 0;
+  for (const auto& [stage, ms] : progress.times_ms())
+    for (const char* s : kToMpi) sum += stage == s ? ms : 0;
+  return sum;
+}
+
+// Photo to MPI only, as `ampi run` does it before writing anything.
+double time_to_mpi(MpiMaker& maker, const std::string& photo_file) {
+  Progress progress(/*quiet=*/true);
+  {
+    cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo_file); });
+    const MpiResult result = maker.make(bgr, photo_file, progress);
+  }
+  release_free_memory();
+  return to_mpi_sum(progress);
+}
 
 struct RunOutcome {
   size_t planes = 0;
@@ -99,9 +123,13 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
     throw std::runtime_error(photo_file + ": cannot write the benchmark photo");
   resized.release();  // not held through the runs, whose memory is measured
   MpiMaker maker{options};
+  MpiOptions plain_options = options;
+  plain_options.snap_depth_edges = false;
+  MpiMaker plain{plain_options};
   for (int k = 0; k <= runs; ++k) {  // run 0 loads the networks and warms the caches
     Progress progress(/*quiet=*/true, /*measure_memory=*/true);
     const RunOutcome outcome = run_once(maker, photo_file, scratch, video, progress);
+    const double plain_ms = time_to_mpi(plain, photo_file);
     r.planes = outcome.planes;
     r.slicing_size = outcome.slicing_size;
     // Memory counts every run, the one that loads the networks included.
@@ -110,6 +138,8 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
       r.peak_mb = std::max(r.peak_mb, mb);
     }
     if (k == 0) continue;
+    r.to_mpi_ms.push_back(to_mpi_sum(progress));
+    r.to_mpi_plain_ms.push_back(plain_ms);
     for (const auto& [stage, ms] : progress.times_ms()) {
       if (!r.ms.count(stage)) r.stages.push_back(stage);
       r.ms[stage].push_back(ms);
@@ -159,6 +189,9 @@ double median_of(const SizeResult& r, const std::string& stage) {
 // same resolution.
 constexpr double kSlicingShareTarget = 0.05;
 constexpr int kSlicingShareReps = 30;
+// Issue 25's target: depth edges that follow the photo add at most this share to the
+// photo-to-MPI time.
+constexpr double kEdgeGrowthTarget = 0.10;
 
 std::string table(const std::vector<SizeResult>& results, const MpiOptions& options, int threads,
                   int frames, int runs) {
@@ -187,15 +220,23 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
          << cell(" %.0f |", r.stage_peak_mb.count(stage) ? r.stage_peak_mb.at(stage) : 0);
     md << "\n";
   }
-  const char* to_mpi[] = {"decode", "reduce", "depth", "slicing", "assembly", "inpainting"};
   md << "| **photo to MPI** (decode..inpainting) |";
   for (const SizeResult& r : results) {
     double sum = 0, peak = 0;
-    for (const char* s : to_mpi) {
+    for (const char* s : kToMpi) {
       sum += median_of(r, s);
       if (r.stage_peak_mb.count(s)) peak = std::max(peak, r.stage_peak_mb.at(s));
     }
     md << cell(" **%.0f** |", sum) << cell(" %.0f |", peak);
+  }
+  md << "\n| photo to MPI, per run (median) |";
+  for (const SizeResult& r : results) md << cell(" %.0f | |", median(r.to_mpi_ms));
+  md << "\n| photo to MPI, `--no-edge-snap` (median) |";
+  for (const SizeResult& r : results) md << cell(" %.0f | |", median(r.to_mpi_plain_ms));
+  md << "\n| **depth edges: photo to MPI grows by** (target <= " << cell("%.0f", 100 * kEdgeGrowthTarget) << "%) |";
+  for (const SizeResult& r : results) {
+    const double growth = median(r.to_mpi_ms) / median(r.to_mpi_plain_ms) - 1;
+    md << cell(" %+.1f%%", 100 * growth) << (growth <= kEdgeGrowthTarget ? " (met)" : " (not met)") << " | |";
   }
   md << "\n| **whole run** (peak of any stage) |";
   for (const SizeResult& r : results) md << " |" << cell(" **%.0f** |", r.peak_mb);
@@ -225,7 +266,11 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
      << "working size) and the slicer on its output alternately, " << kSlicingShareReps
      << " times each, medians: the\ncomparison issue 6 asks for. In the run, the slicer's buffers are touched for the\n"
      << "first time after the heap was handed back (page faults), while the network's arena\n"
-     << "persists, and the depth stage includes shrinking the photo.\n";
+     << "persists, and the depth stage includes shrinking the photo.\n\n"
+     << "Depth edges (slicing/depth_edges.h) are on, as in `ampi run`. Their cost: after every\n"
+     << "measured run, photo to MPI again with `--no-edge-snap` (the map enlarged and sliced as\n"
+     << "it is, no feathering); each row is the median over the runs of that run's decode..\n"
+     << "inpainting total, so the two are taken side by side.\n";
   return md.str();
 }
 

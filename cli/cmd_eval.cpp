@@ -27,6 +27,7 @@
 #include "pipeline/depth_estimate.h"
 #include "pipeline/depth_io.h"
 #include "pipeline/photo_io.h"
+#include "slicing/depth_edges.h"
 #include "weights_format/weight_file.h"
 
 namespace ampi::cli {
@@ -314,14 +315,15 @@ const char kSlicingUsage[] =
     "                         [--amplitude A] [--max-size N] [--model lite|heavy | --weights FILE]\n"
     "                         [--working-size N] [--depth-dir D] [--inpainter push-pull|network]\n"
     "                         [--slicer paper|optimal] [--min-plane-share F] [--tear-penalty P]\n"
-    "                         [--limit N] [--threads N]\n"
+    "                         [--no-edge-snap] [--limit N] [--threads N]\n"
     "\n"
     "The paper's Table 3 (Luvizon et al., WACV 2021: adaptive against uniform slicing, SSIM and\n"
     "PSNR of novel views) on every photo under DIR (.jpg, .jpeg, .png, recursively, sorted).\n"
     "Photos have no second view, so, as the paper does for its own photos, views are compared\n"
     "with those of a densely sampled MPI. Per photo (scaled down to --max-size) and per\n"
-    "maximum plane count N, three MPIs from the same depth (our network, or --depth-dir), the same slicing\n"
-    "depth range and the same inpainting:\n"
+    "maximum plane count N, three MPIs from the same depth (our network, or --depth-dir: the map\n"
+    "snapped to the photo's edges and the layer borders feathered there, as ampi run does), the\n"
+    "same slicing depth range and the same inpainting:\n"
     "  adaptive   adaptive slicing (--slicer: the paper's rule decides the count, the cuts\n"
     "             minimise the squared disparity error; or the paper's cuts), at most N\n"
     "             planes (it makes n)\n"
@@ -350,6 +352,8 @@ const char kSlicingUsage[] =
     "                          F/N of the depth histogram (default 0: the paper's rule exactly)\n"
     "  --tear-penalty P        optimal slicer: a cut also costs P squared levels per pixel of the\n"
     "                          edge-free depth histogram at the cut (default 0)\n"
+    "  --no-edge-snap          the map enlarged bilinearly and sliced as it is (ampi run\n"
+    "                          --no-edge-snap), as before depth edges followed the photo\n"
     "  --limit N               only the first N photos\n"
     "  --threads N             worker threads (default: all hardware threads)\n";
 
@@ -357,6 +361,7 @@ struct SlicingEvalArgs {
   std::string images, model = "lite", weights, depth_dir, inpainter = "push-pull";
   SlicingEvalOptions options;
   int max_size = 512, working_size = 0, limit = 0, threads = 0;
+  bool snap_edges = true;
 };
 
 std::vector<int> parse_counts(const std::string& list) {
@@ -427,6 +432,7 @@ int eval_slicing(int argc, char** argv) {
   p.option("--tear-penalty", &a.options.tear_penalty, 0.0, 1e9);
   p.option("--limit", &a.limit, 0, 1 << 30);
   p.option("--threads", &a.threads, 0, 1024);
+  p.flag("--no-edge-snap", [&] { a.snap_edges = false; });
   if (!p.parse(argc, argv)) return 0;
   if (a.images.empty()) throw std::runtime_error("--images DIR is required (see ampi eval slicing --help)");
   if (a.threads > 0) set_default_threads(a.threads);
@@ -447,10 +453,12 @@ int eval_slicing(int argc, char** argv) {
   for (size_t k = 0; k < photos.size(); ++k) {
     const std::string& path = photos[k];
     const cv::Mat bgr = fit_long_side(read_photo(path), a.max_size);
-    cv::Mat disparity;
-    cv::resize(net ? estimate_disparity(*net, bgr, side) : read_depth_map(depth_maps[k], false), disparity,
-               bgr.size(), 0, 0, cv::INTER_LINEAR);
-    const std::vector<SlicingScore> rows = eval.add(bgr, disparity);
+    cv::Mat map = net ? estimate_disparity(*net, bgr, side) : read_depth_map(depth_maps[k], false);
+    if (map.cols > bgr.cols || map.rows > bgr.rows) cv::resize(map, map, bgr.size(), 0, 0, cv::INTER_AREA);
+    // The map ampi run cuts the layers from: snapped to the photo's edges, or enlarged.
+    const DepthEdges edges =
+        a.snap_edges ? snap_depth_edges(bgr, map) : DepthEdges{enlarge_disparity(map, bgr.size()), cv::Mat()};
+    const std::vector<SlicingScore> rows = eval.add(bgr, edges.disparity, edges.band);
     std::string line;
     for (size_t i = 0; i + 1 < rows.size(); i += 2) {
       psnr_wins[i / 2] += rows[i + 1].psnr > rows[i].psnr;

@@ -41,10 +41,15 @@ OcclusionMaskParams margin_for_photo(const cv::Size& size) {
 }
 
 Mpi inpainted_mpi(const cv::Mat& bgr, const cv::Mat& disparity, const std::vector<Plane>& planes,
-                  const LayerFiller& filler, const SlicingEvalOptions& options) {
+                  const LayerFiller& filler, const SlicingEvalOptions& options, const cv::Mat& band) {
   const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options.fov_degrees);
   Mpi mpi = assemble_mpi(bgr, disparity, planes, camera, options.range);
-  inpaint_mpi(mpi, filler, margin_for_photo(bgr.size()));
+  OcclusionMaskParams margin = margin_for_photo(bgr.size());
+  if (!band.empty()) {
+    feather_depth_edges(mpi, bgr, band, options.edge_feather);
+    margin.dilate_iterations += options.edge_feather;
+  }
+  inpaint_mpi(mpi, filler, margin);
   return mpi;
 }
 
@@ -77,13 +82,13 @@ SlicingEvaluator::SlicingEvaluator(SlicingEvalOptions options, LayerFiller fille
     for (const char* method : {"uniform", "adaptive"}) sums_.push_back({c, method});
 }
 
-std::vector<SlicingScore> SlicingEvaluator::add(const cv::Mat& bgr, const cv::Mat& disparity) {
+std::vector<SlicingScore> SlicingEvaluator::add(const cv::Mat& bgr, const cv::Mat& disparity, const cv::Mat& band) {
   const std::vector<Plane> dense = slice_uniform(disparity, options_.reference_planes, options_.range);
   const std::vector<Pose> poses = target_poses(dense, options_);
   const std::vector<cv::Mat> reference_views =
-      render_views(inpainted_mpi(bgr, disparity, dense, filler_, options_), poses);
+      render_views(inpainted_mpi(bgr, disparity, dense, filler_, options_, band), poses);
   const auto score = [&](int count, const char* method, const std::vector<Plane>& planes) {
-    const ViewScore s = compare_views(render_views(inpainted_mpi(bgr, disparity, planes, filler_, options_), poses),
+    const ViewScore s = compare_views(render_views(inpainted_mpi(bgr, disparity, planes, filler_, options_, band), poses),
                                       reference_views);
     return SlicingScore{count, method, double(planes.size()), s.ssim, s.psnr, 1};
   };

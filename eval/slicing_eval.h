@@ -45,6 +45,7 @@ struct SlicingEvalOptions {
   Slicer slicer = SlicingParams{}.slicer;                    // how the adaptive slicer cuts
   double min_plane_share = SlicingParams{}.min_plane_share;  // the adaptive slicer's guard
   double tear_penalty = SlicingParams{}.tear_penalty;        // its cost of cutting a surface
+  int edge_feather = 2;  // layer borders feathered at depth edges, as ampi run does (with a band)
 };
 
 // One row of the table: a count and a method, averaged over photos.
@@ -61,9 +62,10 @@ struct SlicingScore {
 OcclusionMaskParams margin_for_photo(const cv::Size& size);
 
 // Assembles the MPI of `planes` from the photo and its disparity (same size) and fills
-// its margins with `filler`.
+// its margins with `filler`. With a depth-edge band (snap_depth_edges), the layer
+// borders there are feathered first, as ampi run does.
 Mpi inpainted_mpi(const cv::Mat& bgr, const cv::Mat& disparity, const std::vector<Plane>& planes,
-                  const LayerFiller& filler, const SlicingEvalOptions& options);
+                  const LayerFiller& filler, const SlicingEvalOptions& options, const cv::Mat& band = {});
 
 // The target poses: `options.poses` camera positions evenly spaced on the circle.
 std::vector<Pose> target_poses(const std::vector<Plane>& reference_planes, const SlicingEvalOptions& options);
@@ -82,9 +84,10 @@ class SlicingEvaluator {
   // than 2 reference planes, no poses, amplitude outside (0, 1)).
   SlicingEvaluator(SlicingEvalOptions options, LayerFiller filler);
 
-  // bgr: CV_8UC3; disparity: CV_32FC1 of the same size, larger = nearer. Returns this
+  // bgr: CV_8UC3; disparity: CV_32FC1 of the same size, larger = nearer; band: its
+  // depth-edge band when it was snapped (ampi run's map), else empty. Returns this
   // photo's rows (photos = 1), and adds them to the means.
-  std::vector<SlicingScore> add(const cv::Mat& bgr, const cv::Mat& disparity);
+  std::vector<SlicingScore> add(const cv::Mat& bgr, const cv::Mat& disparity, const cv::Mat& band = {});
 
   // Rows ordered by count, uniform before adaptive; means over the photos added.
   std::vector<SlicingScore> mean() const;

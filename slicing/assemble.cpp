@@ -104,7 +104,7 @@ namespace {
 // Per pixel: 1 + the index of the layer that holds it (layers are back to front, so a
 // larger owner is nearer), 0 where no layer does.
 cv::Mat layer_owners(const Mpi& mpi) {
-  cv::Mat owner(mpi.layers[0].size(), CV_8UC1, cv::Scalar(0));
+  cv::Mat owner(mpi.layers[0].size(), CV_16UC1, cv::Scalar(0));
   for (size_t j = 0; j < mpi.layers.size(); ++j) {
     cv::Mat alpha;
     cv::extractChannel(mpi.layers[j], alpha, 3);
@@ -117,7 +117,6 @@ cv::Mat layer_owners(const Mpi& mpi) {
 
 int64_t feather_depth_edges(Mpi& mpi, const cv::Mat& bgr, const cv::Mat& band, int width) {
   if (mpi.layers.empty() || width <= 0) return 0;
-  if (mpi.layers.size() > 254) throw std::invalid_argument("feather_depth_edges: more than 254 layers");
   const cv::Size size = mpi.layers[0].size();
   if (bgr.size() != size || bgr.type() != CV_8UC3 || band.size() != size || band.type() != CV_8UC1)
     throw std::invalid_argument("feather_depth_edges: the photo and the band must be of the layers' size");
@@ -130,7 +129,8 @@ int64_t feather_depth_edges(Mpi& mpi, const cv::Mat& bgr, const cv::Mat& band, i
     cv::dilate(reach, reach, cv::Mat());
     const uchar alpha = static_cast<uchar>(std::lround(255.0 * (width + 1 - r) / (width + 1)));
     for (int y = 0; y < size.height; ++y) {
-      const uchar *own = owner.ptr<uchar>(y), *near = reach.ptr<uchar>(y), *edge = band.ptr<uchar>(y);
+      const uint16_t *own = owner.ptr<uint16_t>(y), *near = reach.ptr<uint16_t>(y);
+      const uchar* edge = band.ptr<uchar>(y);
       uchar* done = moved.ptr<uchar>(y);
       const cv::Vec3b* colour = bgr.ptr<cv::Vec3b>(y);
       for (int x = 0; x < size.width; ++x) {
