@@ -230,58 +230,33 @@ void local_extremes(const cv::Mat& extended, int pad, int radius, cv::Mat& lo, c
   hi = m(inner).clone();
 }
 
-}  // namespace
-
-cv::Mat enlarge_disparity(const cv::Mat& disparity, cv::Size size) {
-  if (disparity.size() == size) return disparity;
-  cv::Mat out;
-  cv::resize(disparity, out, size, 0, 0, cv::INTER_LINEAR);
-  return out;
-}
-
-DepthEdges snap_depth_edges(const cv::Mat& bgr, const cv::Mat& disparity, const DepthEdgeParams& p, Isa isa) {
-  check_inputs(bgr, disparity, p);
-  if (!cv::checkRange(disparity))
-    throw std::invalid_argument("snap_depth_edges: the disparity map contains NaN or infinite values");
-  const FitInputs fit = fit_inputs(bgr, disparity, p.guide_long_side);
-  const int radius = p.radius > 0 ? p.radius : default_radius(fit.disparity.size(), disparity.size() == bgr.size());
-  DepthEdges out;
-  // Written in place below: a map of the photo's size is copied, a smaller one enlarged
-  // straight into the output.
-  if (disparity.size() == bgr.size())
-    out.disparity = disparity.clone();
-  else
-    cv::resize(disparity, out.disparity, bgr.size(), 0, 0, cv::INTER_LINEAR);
-  out.band = cv::Mat::zeros(bgr.size(), CV_8UC1);
-  double lo_all = 0, hi_all = 0;
-  cv::minMaxLoc(fit.disparity, &lo_all, &hi_all);
-  if (!(hi_all > lo_all)) return out;  // a constant map has no edge
-
-  // Colour in 0..255: the regulariser is a variance in those units.
-  const double eps = std::pow(p.color_sigma * 255.0, 2);
-  const std::array<cv::Mat, 4> coeff = guided_coefficients(fit, radius, eps);
-  const float min_step = static_cast<float>(p.min_step / (kDisparityLevels - 1) * (hi_all - lo_all));
-  const cv::Mat extended = extend_slopes(fit.disparity, 2 * radius);
-  cv::Mat lo, hi, wide_lo, wide_hi;
+// lo and hi of every window near a depth edge, lo = hi elsewhere. A slope spreads twice
+// as much over a window twice as wide, a step no more: the pixels whose spread is at
+// least min_step and stops growing are the cores of edges, and a window holding a core
+// is near an edge (so a ramp wider than the window keeps its ends).
+void edge_extremes(const cv::Mat& d, int radius, float min_step, double min_growth_share, cv::Mat& lo, cv::Mat& hi) {
+  const cv::Mat extended = extend_slopes(d, 2 * radius);
+  cv::Mat wide_lo, wide_hi;
   local_extremes(extended, 2 * radius, radius, lo, hi);
-  // A slope spreads twice as much over a window twice as wide, a step no more. The
-  // pixels whose spread is large and stops growing are the cores of edges; a window
-  // holding a core is near an edge (so a ramp wider than the window keeps its ends).
-  // Everywhere else lo = hi: no edge.
   local_extremes(extended, 2 * radius, 2 * radius, wide_lo, wide_hi);
   const cv::Mat spread = hi - lo;
-  cv::Mat near_edge = (spread >= min_step) & (spread >= p.min_growth_share * (wide_hi - wide_lo));
+  cv::Mat near_edge = (spread >= min_step) & (spread >= min_growth_share * (wide_hi - wide_lo));
   cv::dilate(near_edge, near_edge, cv::getStructuringElement(cv::MORPH_RECT, {2 * radius + 1, 2 * radius + 1}));
   lo.copyTo(hi, ~near_edge);
-  const cv::Mat* planes[6] = {&coeff[0], &coeff[1], &coeff[2], &coeff[3], &lo, &hi};
+}
 
-  const float margin = static_cast<float>(p.ramp_margin);
-  const slicing::SnapRowFn snap_row = slicing::slicing_kernels(isa).snap_row;
+// Every row of the photo: where a fit pixel it is enlarged from is near an edge, the
+// six fit planes (a0, a1, a2, b, lo, hi) enlarged and the row kernel run; out.disparity
+// (the map enlarged) is snapped in place and out.band written.
+void snap_rows(const cv::Mat& bgr, const std::array<const cv::Mat*, 6>& planes, float min_step, float margin,
+               slicing::SnapRowFn snap_row, DepthEdges& out) {
   // A pixel can be near an edge only if one of the fit pixels it is enlarged from is: the
   // enlarged spread is a weighted mean of theirs. Elsewhere the map stays as enlarged.
+  const cv::Mat& lo = *planes[4];
+  const cv::Mat& hi = *planes[5];
   const cv::Mat edge_fit = (hi - lo) >= min_step;
-  const RowEnlarger enlarger(fit.disparity.size(), bgr.size());
-  const int width = bgr.cols, fit_width = fit.disparity.cols;
+  const RowEnlarger enlarger(lo.size(), bgr.size());
+  const int width = bgr.cols, fit_width = lo.cols;
   default_pool().parallel_for(bgr.rows, 16, [&](int64_t begin, int64_t end) {
     // Per fit plane a vertically interpolated row; per input of the kernel a row segment.
     std::vector<float> columns(size_t(fit_width) * 6), segment(size_t(width) * 10);
@@ -317,6 +292,43 @@ DepthEdges snap_depth_edges(const cv::Mat& bgr, const cv::Mat& disparity, const 
       }
     }
   });
+}
+
+}  // namespace
+
+cv::Mat enlarge_disparity(const cv::Mat& disparity, cv::Size size) {
+  if (disparity.size() == size) return disparity;
+  cv::Mat out;
+  cv::resize(disparity, out, size, 0, 0, cv::INTER_LINEAR);
+  return out;
+}
+
+DepthEdges snap_depth_edges(const cv::Mat& bgr, const cv::Mat& disparity, const DepthEdgeParams& p, Isa isa) {
+  check_inputs(bgr, disparity, p);
+  if (!cv::checkRange(disparity))
+    throw std::invalid_argument("snap_depth_edges: the disparity map contains NaN or infinite values");
+  const FitInputs fit = fit_inputs(bgr, disparity, p.guide_long_side);
+  const int radius = p.radius > 0 ? p.radius : default_radius(fit.disparity.size(), disparity.size() == bgr.size());
+  DepthEdges out;
+  // Written in place below: a map of the photo's size is copied, a smaller one enlarged
+  // straight into the output.
+  if (disparity.size() == bgr.size())
+    out.disparity = disparity.clone();
+  else
+    cv::resize(disparity, out.disparity, bgr.size(), 0, 0, cv::INTER_LINEAR);
+  out.band = cv::Mat::zeros(bgr.size(), CV_8UC1);
+  double lo_all = 0, hi_all = 0;
+  cv::minMaxLoc(fit.disparity, &lo_all, &hi_all);
+  if (!(hi_all > lo_all)) return out;  // a constant map has no edge
+
+  // Colour in 0..255: the regulariser is a variance in those units.
+  const double eps = std::pow(p.color_sigma * 255.0, 2);
+  const std::array<cv::Mat, 4> coeff = guided_coefficients(fit, radius, eps);
+  const float min_step = static_cast<float>(p.min_step / (kDisparityLevels - 1) * (hi_all - lo_all));
+  cv::Mat lo, hi;
+  edge_extremes(fit.disparity, radius, min_step, p.min_growth_share, lo, hi);
+  snap_rows(bgr, {&coeff[0], &coeff[1], &coeff[2], &coeff[3], &lo, &hi}, min_step, static_cast<float>(p.ramp_margin),
+            slicing::slicing_kernels(isa).snap_row, out);
   return out;
 }
 
