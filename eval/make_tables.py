@@ -349,8 +349,15 @@ def slicing_table(ampi, threads, scene_count, extra):
     return '\n'.join(lines)
 
 
-def last_lines(out, count):
-    return '\n'.join(out.rstrip().splitlines()[-count:])
+SCENE_NAMES = ('disk', 'pole', 'person', 'two-objects')
+
+
+def after_flawed(row):
+    """Whether a row of ampi eval edges has wrong pixels or fringe after snapping."""
+    fields = row.split()
+    wrong_after = float(fields[5].split('/')[1])
+    fringe_after = int(fields[6].split('/')[1])
+    return wrong_after > 0 or fringe_after > 0
 
 
 def edges_table(ampi, threads):
@@ -385,15 +392,18 @@ def edges_table(ampi, threads):
         '',
         *fenced(out),
         '',
-        'The same scenes textured with crops of validation photos (`--texture`; the verdict lines):',
+        'The same scenes textured with crops of validation photos (`--texture`):',
         '',
     ]
     for photo in textures:
         texture_command = command + ['--texture', photo]
         texture_out, texture_seconds = run(texture_command)
         name = photo.relative_to(root)
-        lines += [f'`{shown(command)} --texture {name}` ({texture_seconds:.0f} s):', '',
-                  *fenced(last_lines(texture_out, 2)), '']
+        header, *rows = texture_out.splitlines()
+        flawed = [r for r in rows if r.split()[:1] and r.split()[0] in SCENE_NAMES and after_flawed(r)]
+        verdicts = [r for r in rows if r.startswith(('softness', '  target', 'poses', 'target'))]
+        lines += [f'`{shown(command)} --texture {name}` ({texture_seconds:.0f} s); the rows with anything',
+                  'wrong after, then the verdicts:', '', *fenced('\n'.join([header] + flawed + verdicts)), '']
     return '\n'.join(lines)
 
 
