@@ -2,6 +2,7 @@
 // depth edges follow the photo (slicing/depth_edges.h).
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <stdexcept>
@@ -13,6 +14,9 @@
 #include "engine/thread_pool.h"
 #include "eval/depth_eval.h"
 #include "eval/edge_eval.h"
+#include "nets/depth_net.h"
+#include "nets/weights_path.h"
+#include "pipeline/depth_estimate.h"
 #include "pipeline/depth_io.h"
 #include "pipeline/make_mpi.h"
 #include "pipeline/photo_io.h"
@@ -26,7 +30,7 @@ namespace fs = std::filesystem;
 const char kUsage[] =
     "usage: ampi eval edges [--size WxH] [--seed N] [--texture PHOTO] [--softness LIST]\n"
     "                       [--pose TX,TY,TZ]... [--max-planes N] [--inpainter I] [-o DIR] [--threads N]\n"
-    "       ampi eval edges --images DIR --depth-dir D -o DIR [--max-size N] [--pose TX,TY,TZ]...\n"
+    "       ampi eval edges --images DIR [--depth-dir D] -o DIR [--max-size N] [--pose TX,TY,TZ]...\n"
     "\n"
     "Do objects stay whole when the camera moves? Scenes of textured fronto-parallel surfaces\n"
     "whose new views are known exactly (each surface warped by its own homography): a disk\n"
@@ -42,9 +46,9 @@ const char kUsage[] =
     "surface's colour). The target: at most 3% wrong and no fringe at poses moving an object\n"
     "40 px or more.\n"
     "\n"
-    "With --images and --depth-dir: for every photo and its depth map (as ampi eval slicing\n"
-    "finds it), writes DIR/<name>.png: the photo and the snapped map above, the view before\n"
-    "and after below, at the first pose.\n"
+    "With --images: for every photo, with its depth map from --depth-dir (as ampi eval slicing\n"
+    "finds it) or the bundled lite network's, writes DIR/<name>.png: the photo and the snapped\n"
+    "map above, the view before and after below, at the first pose.\n"
     "\n"
     "  --size WxH          scene size (default 640x480)\n"
     "  --seed N            texture seed (default 1)\n"
@@ -56,7 +60,7 @@ const char kUsage[] =
     "  --inpainter I       network (default, as ampi run), harmonic or push-pull\n"
     "  -o DIR              also write, per scene and softness, photo | map | exact | before |\n"
     "                      after views at the first pose\n"
-    "  --images DIR        real photos (with --depth-dir)\n"
+    "  --images DIR        real photos\n"
     "  --depth-dir D       their depth maps: D/sub/name.* for DIR/sub/name.jpg\n"
     "  --max-size N        photos are scaled down to this long side (default 1024)\n"
     "  --threads N         worker threads (default: all hardware threads)\n";
@@ -214,17 +218,20 @@ int eval_scenes(const EdgeEvalArgs& a) {
 }
 
 int eval_photos(const EdgeEvalArgs& a) {
-  if (a.depth_dir.empty() || a.output.empty())
-    throw std::runtime_error("--images needs --depth-dir D and -o DIR (see ampi eval edges --help)");
-  if (!fs::is_directory(a.depth_dir)) throw std::runtime_error(a.depth_dir + ": not a directory");
+  if (a.output.empty()) throw std::runtime_error("--images needs -o DIR (see ampi eval edges --help)");
+  if (!a.depth_dir.empty() && !fs::is_directory(a.depth_dir)) throw std::runtime_error(a.depth_dir + ": not a directory");
   const std::vector<std::string> photos = list_images(a.images);
   std::vector<std::string> maps;  // looked up first: a missing one stops at once
-  for (const std::string& photo : photos) maps.push_back(find_depth_reference(photo, a.images, a.depth_dir));
+  if (!a.depth_dir.empty())
+    for (const std::string& photo : photos) maps.push_back(find_depth_reference(photo, a.images, a.depth_dir));
+  // Without maps, the bundled lite network at its working size, as ampi run uses it.
+  std::optional<DepthNet> net;
+  if (maps.empty()) net.emplace(DepthNet::load(find_weights("depth_lite.ampw")));
   fs::create_directories(a.output);
   const Pose pose = pose_of(a.poses[0]);
   for (size_t i = 0; i < photos.size(); ++i) {
     const cv::Mat bgr = fit_long_side(read_photo(photos[i]), a.max_size);
-    cv::Mat disparity = read_depth_map(maps[i], false);
+    cv::Mat disparity = net ? estimate_disparity(*net, bgr, net->working_long_side()) : read_depth_map(maps[i], false);
     if (disparity.cols > bgr.cols || disparity.rows > bgr.rows)
       cv::resize(disparity, disparity, bgr.size(), 0, 0, cv::INTER_AREA);
     const MpiResult before = make_mpi(a, bgr, disparity, false);

@@ -4,7 +4,10 @@ the MPI's layers over a checkerboard, and a small animated GIF of the parallax v
 
 Run from the repository root after building (bash scripts/demo.sh builds):
     /usr/bin/python3 scripts/gallery.py
-Writes docs/gallery/{depth.png, layers.png, parallax.gif}. Needs ffmpeg for the GIF.
+Writes docs/gallery/{depth.png, layers.png, parallax.gif}, and edges.png: `ampi eval
+edges`'s disk scene with its depth made at a quarter of the size (photo, map, the exact
+new view, the view before and after depth edges follow the photo, the camera moved as far
+as ampi run's default path takes it). Needs ffmpeg for the GIF.
 """
 import json
 import os
@@ -71,7 +74,13 @@ def main():
         filters = f"fps=15,scale={THUMB_WIDTH}:-1:flags=lanczos,split[a][b];[a]palettegen[p];[b][p]paletteuse"
         subprocess.run(["ffmpeg", "-loglevel", "error", "-y", "-i", os.path.join(run_dir, "video.mp4"),
                         "-vf", filters, gif], check=True)
-    print(f"wrote {OUT}/depth.png, {OUT}/layers.png, {OUT}/parallax.gif")
+        edges_dir = os.path.join(tmp, "edges")
+        subprocess.run([ampi, "eval", "edges", "--softness", "4", "--pose", "0.05,0,0", "--inpainter", "push-pull",
+                        "-o", edges_dir], check=True, capture_output=True)
+        strip = Image.open(os.path.join(edges_dir, "disk_soft4.png"))
+        strip.resize((strip.width // 2, strip.height // 2), Image.LANCZOS).save(os.path.join(OUT, "edges.png"),
+                                                                               optimize=True)
+    print(f"wrote {OUT}/depth.png, {OUT}/layers.png, {OUT}/parallax.gif, {OUT}/edges.png")
 
 
 if __name__ == "__main__":

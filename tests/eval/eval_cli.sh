@@ -145,7 +145,15 @@ expect_error "edges, bad size" "--size: '10x10'" edges --size 10x10
 expect_error "edges, bad softness" "--softness: '0'" edges --softness 1,0
 expect_error "edges, bad pose" "--pose: '1,2'" edges --pose 1,2
 expect_error "edges, missing texture" "$tmp/none.jpg" edges --texture "$tmp/none.jpg"
-expect_error "edges, photos without maps" "--images needs --depth-dir" edges --images "$tmp/images"
+expect_error "edges, photos without -o" "--images needs -o DIR" edges --images "$tmp/images"
+if "$ampi" eval edges --images "$tmp/images" -o "$tmp/sheets" --max-size 128 --pose 0.05,0,0 >"$tmp/out" 2>"$tmp/err"; then
+  sheets=$(find "$tmp/sheets" -name '*.png' | wc -l)
+  [ "$sheets" -ge 1 ] || fail "eval edges --images: no sheet written"
+  grep -q "planes before" "$tmp/out" || fail "eval edges --images: no line per photo"
+  [ "$sheets" -ge 1 ] && echo "ok: eval edges --images -> $sheets sheet(s)"
+else
+  fail "eval edges --images: exit status $?: $(cat "$tmp/err")"
+fi
 
 [ "$failures" -eq 0 ] || { echo "$failures failure(s)" >&2; exit 1; }
 echo "all eval CLI checks passed"
