@@ -1,6 +1,8 @@
 #include "cli/args.h"
 
+#include <algorithm>
 #include <cerrno>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <stdexcept>
@@ -79,6 +81,38 @@ bool ArgParser::parse(int argc, char** argv) {
     match->apply(argv[++i]);
   }
   return true;
+}
+
+std::vector<int> parse_int_list(const std::string& option, const std::string& text, int lo, int hi,
+                                const std::string& what) {
+  std::vector<int> values;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t comma = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, comma - start);
+    size_t used = 0;
+    int value = 0;
+    try {
+      value = std::stoi(item, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (item.empty() || used != item.size() || value < lo || value > hi)
+      throw std::runtime_error(option + ": '" + item + "' is not " + what + " in " + std::to_string(lo) + ".." +
+                               std::to_string(hi));
+    values.push_back(value);
+    start = comma + 1;
+  }
+  return values;
+}
+
+std::array<double, 3> parse_pose(const std::string& text) {
+  std::array<double, 3> v{};
+  char tail = 0;
+  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !std::isfinite(v[0]) ||
+      !std::isfinite(v[1]) || !std::isfinite(v[2]))
+    throw std::runtime_error("--pose: '" + text + "' is not three numbers TX,TY,TZ");
+  return v;
 }
 
 }  // namespace ampi::cli

@@ -1,6 +1,7 @@
 // A small declarative command-line parser for the subcommands: options bind straight to
 // fields, numbers are range-checked, and every mistake is one line naming the option.
 #pragma once
+#include <array>
 #include <functional>
 #include <string>
 #include <vector>
@@ -36,5 +37,13 @@ class ArgParser {
   std::vector<Option> options_;
   std::vector<std::string>* positionals_ = nullptr;
 };
+
+// A comma-separated list of integers in [lo, hi]; throws std::runtime_error
+// "OPTION: 'ITEM' is not WHAT in LO..HI" for the first bad item.
+std::vector<int> parse_int_list(const std::string& option, const std::string& text, int lo, int hi,
+                                const std::string& what);
+
+// --pose's value: three finite numbers TX,TY,TZ; throws std::runtime_error otherwise.
+std::array<double, 3> parse_pose(const std::string& text);
 
 }  // namespace ampi::cli

@@ -364,27 +364,6 @@ struct SlicingEvalArgs {
   bool snap_edges = true;
 };
 
-std::vector<int> parse_counts(const std::string& list) {
-  std::vector<int> counts;
-  size_t start = 0;
-  while (start <= list.size()) {
-    const size_t comma = std::min(list.find(',', start), list.size());
-    const std::string item = list.substr(start, comma - start);
-    size_t used = 0;
-    int value = 0;
-    try {
-      value = std::stoi(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (item.empty() || used != item.size() || value < 1 || value > 255)
-      throw std::runtime_error("--counts: '" + item + "' is not a plane count in 1..255");
-    counts.push_back(value);
-    start = comma + 1;
-  }
-  return counts;
-}
-
 LayerFiller slicing_filler(const std::string& inpainter) {
   if (inpainter == "push-pull") return push_pull_filler();
   return inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(find_weights("inpaint.ampw"))));
@@ -411,7 +390,7 @@ int eval_slicing(int argc, char** argv) {
   SlicingEvalArgs a;
   ArgParser p("ampi eval slicing", kSlicingUsage);
   p.option("--images", &a.images);
-  p.option("--counts", [&](const std::string& v) { a.options.counts = parse_counts(v); });
+  p.option("--counts", [&](const std::string& v) { a.options.counts = parse_int_list("--counts", v, 1, 255, "a plane count"); });
   p.option("--reference-planes", &a.options.reference_planes, 2, 255);
   p.option("--poses", &a.options.poses, 1, 1000);
   p.option("--amplitude", &a.options.amplitude, 1e-6, 0.999);

@@ -82,31 +82,6 @@ cv::Size parse_size(const std::string& text) {
   return {w, h};
 }
 
-std::vector<int> parse_factors(const std::string& text) {
-  std::vector<int> out;
-  size_t start = 0;
-  while (start <= text.size()) {
-    const size_t comma = std::min(text.find(',', start), text.size());
-    const std::string item = text.substr(start, comma - start);
-    int v = 0;
-    char tail = 0;
-    if (std::sscanf(item.c_str(), "%d%c", &v, &tail) != 1 || v < 1 || v > 64)
-      throw std::runtime_error("--softness: '" + item + "' is not a factor in 1..64");
-    out.push_back(v);
-    start = comma + 1;
-  }
-  return out;
-}
-
-cv::Vec3d parse_pose(const std::string& text) {
-  cv::Vec3d v;
-  char tail = 0;
-  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 || !std::isfinite(v[0]) ||
-      !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    throw std::runtime_error("--pose: '" + text + "' is not three numbers TX,TY,TZ");
-  return v;
-}
-
 Pose pose_of(const cv::Vec3d& t) {
   Pose pose;
   pose.t = t;
@@ -258,8 +233,9 @@ int eval_edges(int argc, char** argv) {
   p.option("--size", [&](const std::string& v) { a.size = parse_size(v); });
   p.option("--seed", &a.seed, 0, 1 << 30);
   p.option("--texture", &a.texture);
-  p.option("--softness", [&](const std::string& v) { a.softness = parse_factors(v); });
-  p.option("--pose", [&](const std::string& v) { a.poses.push_back(parse_pose(v)); });
+  p.option("--softness", [&](const std::string& v) { a.softness = parse_int_list("--softness", v, 1, 64, "a factor"); });
+  p.option("--pose", [&](const std::string& v) { const std::array<double, 3> t = parse_pose(v);
+    a.poses.push_back({t[0], t[1], t[2]}); });
   p.option("--max-planes", &a.max_planes, 1, 255);
   p.option("--inpainter", [&](const std::string& v) { a.inpainter = parse_inpainter(v); });
   p.option("-o", &a.output);

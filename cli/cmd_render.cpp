@@ -68,15 +68,6 @@ struct RenderOptions {
   int threads = 0;
 };
 
-cv::Vec3d parse_triple(const std::string& text) {
-  cv::Vec3d v;
-  char tail = 0;
-  if (std::sscanf(text.c_str(), "%lf,%lf,%lf%c", &v[0], &v[1], &v[2], &tail) != 3 ||
-      !std::isfinite(v[0]) || !std::isfinite(v[1]) || !std::isfinite(v[2]))
-    throw std::runtime_error("--pose: '" + text + "' is not three numbers TX,TY,TZ");
-  return v;
-}
-
 // Parses the command line; returns nullopt after --help.
 std::optional<RenderOptions> parse(int argc, char** argv) {
   RenderOptions o;
@@ -85,7 +76,8 @@ std::optional<RenderOptions> parse(int argc, char** argv) {
   p.positionals(&positionals);
   p.option("-o", &o.output);
   p.option("--output", &o.output);
-  p.option("--pose", [&](const std::string& v) { o.pose = parse_triple(v); });
+  p.option("--pose", [&](const std::string& v) { const std::array<double, 3> t = parse_pose(v);
+    o.pose = cv::Vec3d(t[0], t[1], t[2]); });
   p.option("--trajectory", [&](const std::string& v) {
     o.trajectory = v;
     o.trajectory_given = true;
