@@ -161,7 +161,6 @@ int eval_scenes(const EdgeEvalArgs& a) {
       const cv::Mat soft = soften_disparity(scene.disparity, factor);
       const MpiResult before = make_mpi(a, scene.photo, soft, false);
       const MpiResult after = make_mpi(a, scene.photo, soft, true);
-      const Renderer render_before(before.mpi), render_after(after.mpi);
       for (size_t k = 0; k < a.poses.size(); ++k) {
         const Pose pose = pose_of(a.poses[k]);
         const EdgeScore b = judge.score(before.mpi, before.fill_masks, pose);
@@ -176,7 +175,7 @@ int eval_scenes(const EdgeEvalArgs& a) {
         if (k == 0 && !a.output.empty()) {
           cv::Mat strip;
           cv::hconcat(std::vector<cv::Mat>{scene.photo, grey_map(soft), judge.exact_view(pose),
-                                           render_before.render(pose), render_after.render(pose)},
+                                           Renderer(before.mpi).render(pose), Renderer(after.mpi).render(pose)},
                       strip);
           write_png((fs::path(a.output) / (scene.name + "_soft" + std::to_string(factor) + ".png")).string(), strip);
         }

@@ -213,25 +213,13 @@ Mpi EdgeJudge::label_mpi(const Mpi& mpi, const std::vector<cv::Mat>& fill_masks)
   if (fill_masks.size() != mpi.layers.size()) throw std::invalid_argument("EdgeJudge: one fill mask per layer");
   Mpi labels = mpi;
   for (size_t j = 0; j < mpi.layers.size(); ++j) {
-    const cv::Mat& layer = mpi.layers[j];
-    cv::Mat own(size, CV_8UC1, cv::Scalar(0)), filled(size, CV_8UC1, cv::Scalar(0));
-    cv::Mat weights(size, CV_32FC3, cv::Scalar(0, 0, 0));
-    for (int y = 0; y < size.height; ++y)
-      for (int x = 0; x < size.width; ++x) {
-        if (layer.at<cv::Vec4b>(y, x)[3] == 0) continue;
-        if (fill_masks[j].at<uchar>(y, x)) {
-          filled.at<uchar>(y, x) = 255;
-        } else {  // the layer's own pixel: it shows the photo there
-          own.at<uchar>(y, x) = 255;
-          weights.at<cv::Vec3f>(y, x) = source_weights_.at<cv::Vec3f>(y, x);
-        }
-      }
-    if (cv::countNonZero(filled) > 0 && cv::countNonZero(own) > 0) {
-      const cv::Mat estimate = push_pull_estimate(weights, own);
-      estimate.copyTo(weights, filled);
-    }
     cv::Mat alpha, colour;
-    cv::extractChannel(layer, alpha, 3);
+    cv::extractChannel(mpi.layers[j], alpha, 3);
+    const cv::Mat filled = (alpha > 0) & (fill_masks[j] != 0);
+    const cv::Mat own = (alpha > 0) & (fill_masks[j] == 0);  // these show the photo
+    cv::Mat weights(size, CV_32FC3, cv::Scalar(0, 0, 0));
+    source_weights_.copyTo(weights, own);
+    if (cv::countNonZero(filled) > 0 && cv::countNonZero(own) > 0) push_pull_estimate(weights, own).copyTo(weights, filled);
     weights.convertTo(colour, CV_8UC3, 255.0);
     labels.layers[j] = cv::Mat();  // a new image: the copy shares the MPI's
     cv::merge(std::vector<cv::Mat>{colour, alpha}, labels.layers[j]);
@@ -287,11 +275,9 @@ EdgeScore EdgeJudge::score(const Mpi& mpi, const std::vector<cv::Mat>& fill_mask
       if (most > owner && revealed[owner].at<float>(y, x) >= 0.5f) ++score.fringe;
     }
   // The nearest object's motion against the background, at its centroid.
-  const cv::Moments m = cv::moments(exact_.layers.size() > 1 ? [&] {
-    cv::Mat a;
-    cv::extractChannel(exact_.layers[n - 1], a, 3);
-    return a;
-  }() : cv::Mat(size, CV_8UC1, cv::Scalar(255)));
+  cv::Mat nearest;
+  cv::extractChannel(exact_.layers[n - 1], nearest, 3);
+  const cv::Moments m = cv::moments(nearest);
   if (m.m00 > 0) {
     const cv::Vec3d c(m.m10 / m.m00, m.m01 / m.m00, 1);
     auto moved = [&](const cv::Matx33d& H) {

@@ -33,23 +33,13 @@ void check_options(const SlicingEvalOptions& o) {
 
 }  // namespace
 
-OcclusionMaskParams margin_for_photo(const cv::Size& size) {
-  const double scale = std::max(size.width, size.height) / 1024.0;
-  OcclusionMaskParams params;
-  params.dilate_iterations = std::max(1, static_cast<int>(std::lround(40 * std::max(scale, 0.25))));
-  return params;
-}
-
 Mpi inpainted_mpi(const cv::Mat& bgr, const cv::Mat& disparity, const std::vector<Plane>& planes,
                   const LayerFiller& filler, const SlicingEvalOptions& options, const cv::Mat& band) {
   const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options.fov_degrees);
   Mpi mpi = assemble_mpi(bgr, disparity, planes, camera, options.range);
-  OcclusionMaskParams margin = margin_for_photo(bgr.size());
-  if (!band.empty()) {
-    feather_depth_edges(mpi, bgr, band, options.edge_feather);
-    margin.dilate_iterations += options.edge_feather;
-  }
-  inpaint_mpi(mpi, filler, margin);
+  const int feathered = band.empty() ? 0 : options.edge_feather;
+  feather_depth_edges(mpi, bgr, band, feathered);
+  inpaint_mpi(mpi, filler, margin_for_photo(bgr.size(), feathered));
   return mpi;
 }
 

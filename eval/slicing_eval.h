@@ -57,10 +57,6 @@ struct SlicingScore {
   int photos = 0;
 };
 
-// The occluded margin ampi run fills: 40 px at a 1024 px long side (the paper's 3x3
-// element dilated 40 times), scaled with the photo, at least a quarter of that.
-OcclusionMaskParams margin_for_photo(const cv::Size& size);
-
 // Assembles the MPI of `planes` from the photo and its disparity (same size) and fills
 // its margins with `filler`. With a depth-edge band (snap_depth_edges), the layer
 // borders there are feathered first, as ampi run does.

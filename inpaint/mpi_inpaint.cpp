@@ -46,9 +46,9 @@ cv::Rect fill_region(const cv::Mat& fill, int context) {
 }  // namespace
 
 int64_t inpaint_mpi(Mpi& mpi, const LayerFiller& filler, const OcclusionMaskParams& params,
-                    std::vector<cv::Mat>* filled_masks) {
+                    std::vector<cv::Mat>* fill_masks) {
   const std::vector<cv::Mat> masks = occlusion_masks(mpi.layers, params);
-  if (filled_masks) *filled_masks = masks;
+  if (fill_masks) *fill_masks = masks;
   int64_t filled = 0;
   for (size_t j = 0; j < mpi.layers.size(); ++j) {
     const int count = cv::countNonZero(masks[j]);

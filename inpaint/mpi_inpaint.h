@@ -30,8 +30,8 @@ const char* inpainter_name(Inpainter kind);
 // For every layer: computes its occlusion mask, fills those pixels with `filler` from
 // the layer's own pixels, and makes them opaque. Pixels outside the masks are untouched,
 // so transparent regions stay transparent. Returns the number of pixels filled; with
-// `filled`, also each layer's mask of them (evaluations trace what was invented).
+// `fill_masks`, also each layer's mask of them (evaluations trace what was invented).
 int64_t inpaint_mpi(Mpi& mpi, const LayerFiller& filler, const OcclusionMaskParams& params = {},
-                    std::vector<cv::Mat>* filled = nullptr);
+                    std::vector<cv::Mat>* fill_masks = nullptr);
 
 }  // namespace ampi

@@ -1,5 +1,7 @@
 #include "inpaint/occlusion_mask.h"
 
+#include <algorithm>
+#include <cmath>
 #include <opencv2/imgproc.hpp>
 
 namespace ampi {
@@ -25,6 +27,13 @@ std::vector<cv::Mat> occlusion_masks(const std::vector<cv::Mat>& layers,
     hidden_by_nearer |= coverage;
   }
   return masks;
+}
+
+OcclusionMaskParams margin_for_photo(const cv::Size& size, int feathered) {
+  const double scale = std::max(size.width, size.height) / 1024.0;
+  OcclusionMaskParams params;
+  params.dilate_iterations = std::max(1, static_cast<int>(std::lround(40 * std::max(scale, 0.25)))) + feathered;
+  return params;
 }
 
 }  // namespace ampi

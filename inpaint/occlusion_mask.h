@@ -18,4 +18,10 @@ struct OcclusionMaskParams {
 std::vector<cv::Mat> occlusion_masks(const std::vector<cv::Mat>& layers,
                                      const OcclusionMaskParams& params = {});
 
+// The margin ampi run fills for a photo of this size: the paper's 40 px at a 1024 px
+// long side, scaled with the photo, at least a quarter of that; plus `feathered`, the
+// border pixels feathering moved from the farther layers (feather_depth_edges), so the
+// margin still reaches as far past their remaining pixels.
+OcclusionMaskParams margin_for_photo(const cv::Size& size, int feathered = 0);
+
 }  // namespace ampi

@@ -24,18 +24,6 @@ LayerFiller make_layer_filler(Inpainter kind, const std::string& weights) {
   return inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(path)));
 }
 
-namespace {
-
-// The margin to fill scales with the photo: the paper's 40 px are at about 1024 px.
-OcclusionMaskParams margin_for(const cv::Size& size) {
-  OcclusionMaskParams params;
-  const double scale = std::max(size.width, size.height) / 1024.0;
-  params.dilate_iterations = std::max(1, static_cast<int>(std::lround(40 * std::max(scale, 0.25))));
-  return params;
-}
-
-}  // namespace
-
 MpiMaker::MpiMaker(MpiOptions options) : options_(std::move(options)) {
   if (options_.working_size != 0 && options_.working_size < kMinPhotoSide)
     throw std::invalid_argument("working size must be at least " + std::to_string(kMinPhotoSide) + " px");
@@ -119,34 +107,25 @@ std::vector<Plane> MpiMaker::slice(const cv::Mat& disparity, cv::Size depth_size
 
 MpiResult MpiMaker::make_from_disparity(const cv::Mat& bgr, const cv::Mat& disparity, Progress& progress) {
   MpiResult result;
-  if (!options_.snap_depth_edges) {
-    // The paper's way: slice the map as the network made it, cut the layers from it
-    // enlarged bilinearly.
-    std::vector<Plane> planes = progress.stage("slicing", [&] { return slice(disparity, disparity.size(), result); });
-    result.mpi = progress.stage("assembly", [&] {
-      result.disparity = enlarge_disparity(disparity, bgr.size());
-      const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
-      return assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range, options_.soft_alpha);
-    });
-  } else {
-    const DepthEdges edges =
-        progress.stage("depth edges", [&] { return snap_depth_edges(bgr, disparity, options_.depth_edges); });
-    result.disparity = edges.disparity;
-    std::vector<Plane> planes = progress.stage("slicing", [&] { return slice(result.disparity, disparity.size(), result); });
-    result.mpi = progress.stage("assembly", [&] {
-      const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
-      Mpi mpi = assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range, options_.soft_alpha);
-      if (options_.soft_alpha == 0) feather_depth_edges(mpi, bgr, edges.band, options_.edge_feather);
-      return mpi;
-    });
-  }
+  const bool snap = options_.snap_depth_edges;
+  DepthEdges edges;
+  if (snap) edges = progress.stage("depth edges", [&] { return snap_depth_edges(bgr, disparity, options_.depth_edges); });
+  // Without snapping, the paper's way: the map is sliced as depth made it and the layers
+  // are cut from it enlarged bilinearly.
+  std::vector<Plane> planes =
+      progress.stage("slicing", [&] { return slice(snap ? edges.disparity : disparity, disparity.size(), result); });
+  const int feathered = snap && options_.soft_alpha == 0 ? options_.edge_feather : 0;
+  result.mpi = progress.stage("assembly", [&] {
+    result.disparity = snap ? edges.disparity : enlarge_disparity(disparity, bgr.size());
+    const Camera camera = camera_from_fov(bgr.cols, bgr.rows, options_.fov_degrees);
+    Mpi mpi = assemble_mpi(bgr, result.disparity, planes, camera, options_.slicing.range, options_.soft_alpha);
+    feather_depth_edges(mpi, bgr, edges.band, feathered);
+    return mpi;
+  });
   LayerFiller& fill = filler();
-  OcclusionMaskParams margin = margin_for(bgr.size());
-  // Feathering took the border pixels from the farther layers: the margin starts that
-  // much nearer their remaining pixels.
-  if (options_.snap_depth_edges && options_.soft_alpha == 0) margin.dilate_iterations += options_.edge_feather;
   progress.stage("inpainting", [&] {
-    return inpaint_mpi(result.mpi, fill, margin, options_.keep_fill_masks ? &result.fill_masks : nullptr);
+    return inpaint_mpi(result.mpi, fill, margin_for_photo(bgr.size(), feathered),
+                       options_.keep_fill_masks ? &result.fill_masks : nullptr);
   });
   result.inpainter = inpainter_;
   return result;

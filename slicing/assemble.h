@@ -34,7 +34,7 @@ Mpi assemble_mpi(const cv::Mat& bgr, const cv::Mat& disparity, const std::vector
 // by the nearer layer, so the inpainter fills them from the farther layer's own pixels
 // and no foreground colour is smeared into the background's margin. The photo is
 // reproduced in the source view up to that ramp over the filled background.
-// Returns the number of pixels moved.
+// Returns the number of pixels moved; width 0 moves none.
 int64_t feather_depth_edges(Mpi& mpi, const cv::Mat& bgr, const cv::Mat& band, int width);
 
 }  // namespace ampi

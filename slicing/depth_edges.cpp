@@ -106,8 +106,10 @@ void box_means(int height, int width, int channels, int radius, Source source, S
 }
 
 // The colour guided filter's coefficients, averaged over the windows that hold each
-// pixel (the filter's output is a . colour + b with these): planes a0, a1, a2 (per unit
-// of blue, green, red) and b.
+// pixel: planes a0, a1, a2 (per unit of blue, green, red) and b = -a . mean(colour), so
+// that a . colour + b is how far a pixel's colour moves its disparity from its window's
+// mean (the filter's own output adds that mean; the snapping adds the pixel's own
+// disparity instead).
 std::array<cv::Mat, 4> guided_coefficients(const FitInputs& fit, int radius, double eps) {
   const cv::Mat& d = fit.disparity;
   const int h = d.rows, w = d.cols;

@@ -10,18 +10,20 @@
 //      reduced to guide_long_side), the guided filter (He, Sun and Tang, "Guided Image
 //      Filtering", ECCV 2010 / TPAMI 2013; the colour form) fits the disparity in every
 //      window of side 2 radius + 1 as a linear function of the photo's colour:
-//      d ~ a . colour + b. Its coefficients, enlarged to the photo's size, give each
-//      full-resolution pixel the disparity its own colour predicts (the "fast guided
-//      filter" way of upsampling, He and Sun 2015).
+//      d ~ mean(d) + a . (colour - mean(colour)). Its coefficients, enlarged to the
+//      photo's size (the "fast guided filter" way of upsampling, He and Sun 2015), say
+//      how far each full-resolution pixel's own colour moves its disparity.
 //   2. The local extremes of the disparity over the same windows (lo, hi) say where a
 //      depth edge is: hi - lo of at least min_step levels of the 0..255 map, and not
 //      much less than over windows twice as wide (a slope, such as a ground plane,
 //      spreads twice as much there; a step the same); the pixels within a window of
 //      such an edge's core are near it.
-//   3. A pixel near such an edge whose disparity lies strictly inside the ramp takes the
-//      extreme of the side its colour fits: hi if the fit is at least (lo + hi) / 2,
-//      else lo. Every other pixel keeps its disparity, so where the map has no edge (or
-//      its edges are already sharp) nothing changes.
+//   3. A pixel near such an edge whose disparity d lies strictly inside the ramp takes
+//      the extreme of the side d and its colour point to: hi if d + a . (colour -
+//      mean(colour)) is at least (lo + hi) / 2, else lo. Where colour tells the sides
+//      apart it decides; where it does not, the ramp is split at its middle. Every other
+//      pixel keeps its disparity, so where the map has no edge (or its edges are
+//      already sharp) nothing changes.
 // The result has two sides and nothing between them wherever a ramp was, so the slicer
 // finds the two surfaces as two planes whatever the ramp's width, and the object's rim
 // travels with the object.

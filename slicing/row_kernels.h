@@ -68,15 +68,17 @@ using NormalizeRowFn = void (*)(const float* in, int n, double lo, double scale,
                                 uint8_t* level);
 
 // One row of depth-edge snapping (slicing/depth_edges.h), every input a row of n floats
-// at the photo's resolution: the disparity, the photo's blue, green and red (0..255),
-// the colour-guided fit of the disparity (g = a0 B + a1 G + a2 R + b) and the local
-// extremes of the disparity (lo, hi). For x in [0, n):
+// at the photo's resolution: the disparity d, the photo's blue, green and red (0..255),
+// the colour-guided fit's coefficients (a0 B + a1 G + a2 R + b: how far the pixel's
+// colour puts its disparity from its window's mean) and the local extremes of the
+// disparity (lo, hi). For x in [0, n):
 //   band[x] = hi - lo >= min_step ? 255 : 0   (a depth edge is near)
 //   a pixel of the band strictly inside the ramp, lo + margin (hi - lo) < d < hi -
-//   margin (hi - lo), takes the side its colour fits: out = g >= (lo + hi) / 2 ? hi : lo;
+//   margin (hi - lo), takes the side d and its colour point to: with
+//   g = d + a0 B + a1 G + a2 R + b, out = g >= (lo + hi) / 2 ? hi : lo;
 //   every other pixel keeps its disparity: out = d.
-// g is fma(a2, R, fma(a1, G, fma(a0, B, b))) in float in every variant, so all agree bit
-// for bit.
+// g is fma(a2, R, fma(a1, G, fma(a0, B, b + d))) in float in every variant, so all agree
+// bit for bit.
 struct SnapRowInputs {
   const float* disparity;
   const float* blue;
