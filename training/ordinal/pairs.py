@@ -3,13 +3,15 @@
 them by eye, and the merged label file.
 
     /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json
-    /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--only REL...]
+    /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--round N] [--only REL...]
     /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
 
 Pairs come from a fixed seed and each photo's own name, so `sample` always makes the same
-file. Per photo: RANDOM_PAIRS pairs of points uniform over the photo, and EDGE_PAIRS pairs
-straddling a strong image edge (the two points on either side of it, along the gradient),
-so the set also asks about object boundaries. Nothing here looks at any network's output:
+file. Per photo and round: RANDOM_PAIRS pairs of points uniform over the photo, and
+EDGE_PAIRS pairs straddling a strong image edge (the two points on either side of it, along
+the gradient), so the set also asks about object boundaries. Rounds were labelled one after
+another (round 1: pairs 1-7, round 2: pairs 8-14); a new round adds pairs and leaves the
+earlier ones, and their labels, as they were. Nothing here looks at any network's output:
 the labels are what a person (or labelling agent) sees in the marked image
 (INSTRUCTIONS.md). Coordinates are pixels of the photo upright (turned by its EXIF orientation, as
 `ampi` reads it; x right, y down).
@@ -42,6 +44,8 @@ EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the
 EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
 ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
+ROUNDS = 2
+PAIRS_PER_ROUND = RANDOM_PAIRS + EDGE_PAIRS
 LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
 PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
            (0, 230, 230), (255, 140, 0)]
@@ -53,8 +57,10 @@ def load_upright(path):
         return ImageOps.exif_transpose(image).convert('RGB')
 
 
-def photo_rng(rel):
-    digest = hashlib.sha256(f'{SEED}:{rel}'.encode()).digest()
+def photo_rng(rel, round_no):
+    """Round 1 keeps the stream it was labelled with; later rounds get their own."""
+    key = f'{SEED}:{rel}' if round_no == 1 else f'{SEED}:{rel}:round{round_no}'
+    digest = hashlib.sha256(key.encode()).digest()
     return np.random.default_rng(int.from_bytes(digest[:8], 'little'))
 
 
@@ -97,13 +103,19 @@ def edge_pairs(rng, gray, count):
     return out
 
 
+def round_of(pair_id):
+    return (pair_id - 1) // PAIRS_PER_ROUND + 1
+
+
 def sample_photo(path, rel):
-    rng = photo_rng(rel)
     rgb = load_upright(path)
     w, h = rgb.size
     gray = np.asarray(rgb.convert('L').filter(ImageFilter.GaussianBlur(2)), np.float32)
-    pairs = [('random', a, b) for a, b in random_pairs(rng, w, h, RANDOM_PAIRS)]
-    pairs += [('edge', a, b) for a, b in edge_pairs(rng, gray, EDGE_PAIRS)]
+    pairs = []
+    for round_no in range(1, ROUNDS + 1):
+        rng = photo_rng(rel, round_no)
+        pairs += [('random', a, b) for a, b in random_pairs(rng, w, h, RANDOM_PAIRS)]
+        pairs += [('edge', a, b) for a, b in edge_pairs(rng, gray, EDGE_PAIRS)]
     return {'photo': rel, 'width': w, 'height': h, 'split': scenes.ordinal_split(path),
             'pairs': [{'id': i + 1, 'kind': kind,
                        'a': [round(float(a[0]), 1), round(float(a[1]), 1)],
@@ -138,14 +150,14 @@ def mark(draw, xy, shape, colour, text, radius, text_size):
               stroke_width=2, stroke_fill=(0, 0, 0))
 
 
-def draw_photo(path, entry):
-    """The photo at DISPLAY_LONG_SIDE with every pair marked (A a circle, B a square, one
-    colour per pair), and below it an enlarged crop around each edge pair."""
+def draw_photo(path, entry, round_no):
+    """The photo at DISPLAY_LONG_SIDE with every pair of one round marked (A a circle,
+    B a square, one colour per pair), and below it an enlarged crop around each edge pair."""
     photo = load_upright(path)
     scale = DISPLAY_LONG_SIDE / max(photo.size)
     shown = photo.resize((round(photo.width * scale), round(photo.height * scale)), Image.LANCZOS)
     draw = ImageDraw.Draw(shown)
-    pairs = entry['pairs']
+    pairs = [p for p in entry['pairs'] if round_of(p['id']) == round_no]
     for pair in pairs:
         colour = PALETTE[(pair['id'] - 1) % len(PALETTE)]
         for key, shape in (('a', 'circle'), ('b', 'square')):
@@ -187,7 +199,7 @@ def cmd_draw(args):
         entries = [e for e in entries if e['photo'] in set(args.only)]
     for entry in entries:
         target = out / (entry['photo'].replace('/', '__').rsplit('.', 1)[0] + '.png')
-        draw_photo(root / entry['photo'], entry).save(target)
+        draw_photo(root / entry['photo'], entry, args.round).save(target)
     print(f'{out}: {len(entries)} marked images')
 
 
@@ -263,6 +275,8 @@ def main():
     sub.add_parser('sample', help='draw the pairs of every photo into pairs.json')
     d = sub.add_parser('draw', help='write the marked images to label')
     d.add_argument('--out', required=True)
+    d.add_argument('--round', type=int, default=ROUNDS, choices=range(1, ROUNDS + 1),
+                   help='which round of pairs to mark (default the newest)')
     d.add_argument('--only', nargs='*', help='photos (relative names) to draw, default all')
     sub.add_parser('merge', help='labels/*.tsv -> ordinal.json')
     args = ap.parse_args()
