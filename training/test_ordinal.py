@@ -95,7 +95,11 @@ class Labelling(unittest.TestCase):
             with unittest.mock.patch.object(pairs.scenes, "ordinal_split", return_value="train"):
                 first, again = pairs.sample_photo(path, "x/p.png"), pairs.sample_photo(path, "x/p.png")
         self.assertEqual(first, again)
-        self.assertEqual([p["kind"] for p in first["pairs"]], ["random"] * 5 + ["edge"] * 2)
+        one_round = ["random"] * pairs.RANDOM_PAIRS + ["edge"] * pairs.EDGE_PAIRS
+        self.assertEqual([p["kind"] for p in first["pairs"]], one_round * pairs.ROUNDS)
+        self.assertEqual([p["id"] for p in first["pairs"]], list(range(1, pairs.ROUNDS * len(one_round) + 1)))
+        self.assertEqual([pairs.round_of(p["id"]) for p in first["pairs"]],
+                         [r for r in range(1, pairs.ROUNDS + 1) for _ in one_round])
         for pair in first["pairs"]:
             for x, y in (pair["a"], pair["b"]):
                 self.assertTrue(0 <= x < 300 and 0 <= y < 200, pair)
