@@ -34,8 +34,8 @@ int render_benchmark(int argc, char** argv);
 // per-stage times of `ampi run` and peak memory at 1024x768 and 4K (pipeline_bench.cpp).
 int pipeline_benchmark(int argc, char** argv);
 
-// ampi bench network --input RGB.npy [--model lite|heavy] [--threads LIST] [--runs N]
-// [--save PREFIX]: DepthNet::run alone, one JSON line per thread count; the ampi side of
+// ampi bench network --input RGB.npy [--model NAME] [--threads LIST] [--runs N]
+// [--save PREFIX]: DepthModel::run alone, one JSON line per thread count; the ampi side of
 // the peer benchmark, bench/peers/run.sh (network_bench.cpp).
 int network_benchmark(int argc, char** argv);
 

@@ -16,8 +16,8 @@
 #include "bench/machine_limits.h"
 #include "engine/tensor.h"
 #include "kernels/conv.h"
-#include "nets/depth_net.h"
-#include "nets/weights_path.h"
+#include "nets/model_loader.h"
+#include "nets/bundled_weights.h"
 
 namespace ampi::bench {
 namespace {
@@ -283,7 +283,7 @@ struct Scaling {
 };
 
 Scaling network_scaling(const std::string& weights, int runs) {
-  DepthNet net = DepthNet::load(weights);
+  const std::unique_ptr<DepthModel> net = load_depth_model(weights);
   Tensor rgb = Tensor::empty({kNetworkH, kNetworkW, 3});
   const std::vector<float> values = random_floats(static_cast<size_t>(rgb.numel()), 4);
   // Pixels in [0, 1], as a decoded photo's are.
@@ -291,7 +291,7 @@ Scaling network_scaling(const std::string& weights, int runs) {
   ThreadPool one(1), two(2);
   const auto seconds = [&](ThreadPool& pool) {
     const Stopwatch watch(Clock::Wall, pool.size());
-    net.run(rgb.f32(), kNetworkH, kNetworkW, pool);
+    net->run(rgb.f32(), kNetworkH, kNetworkW, pool);
     return watch.seconds();
   };
   seconds(one);  // warm-up: plans the arena, touches its pages
@@ -307,7 +307,7 @@ Scaling network_scaling(const std::string& weights, int runs) {
 std::string scaling_section(const std::string& weights, const Scaling& s, int runs) {
   std::ostringstream out;
   out << "\n## Whole lite network, 2 threads vs 1\n\n"
-      << "`" << weights << "` on a " << kNetworkW << "x" << kNetworkH << " image (DepthNet::run, "
+      << "`" << weights << "` on a " << kNetworkW << "x" << kNetworkH << " image (DepthModel::run, "
       << isa_name(active_isa()) << "), median of " << runs
       << " runs each, 1- and 2-thread runs alternating, wall clock.\n\n"
       << "| threads | ms |\n|---:|---:|\n"
@@ -349,7 +349,7 @@ int kernels_benchmark(int argc, char** argv) {
     std::fflush(stdout);
     table += line;
   }
-  const std::string weights = find_weights("depth_lite.ampw");
+  const std::string weights = depth_weights_path({}, "lite");
   const Scaling scaling = network_scaling(weights, o.runs);
   const std::string network = scaling_section(weights, scaling, o.runs);
   std::fputs(network.c_str(), stdout);

@@ -1,4 +1,4 @@
-// ampi bench network: DepthNet::run alone, timed on a given input, so that the peer
+// ampi bench network: DepthModel::run alone, timed on a given input, so that the peer
 // benchmark (bench/peers/run.sh) can put ampi beside ONNX Runtime, OpenCV DNN and
 // PyTorch running the same network on the same pixels. Prints one JSON line per thread
 // count (what bench/peers/run_peers.py reads) and can save the output as .npy.
@@ -13,24 +13,24 @@
 #include "cli/args.h"
 #include "engine/isa.h"
 #include "engine/thread_pool.h"
-#include "nets/depth_net.h"
-#include "nets/weights_path.h"
+#include "nets/model_loader.h"
+#include "nets/bundled_weights.h"
 #include "weights_format/npy.h"
 
 namespace ampi::bench {
 namespace {
 
 const char kUsage[] =
-    "usage: ampi bench network --input RGB.npy [--model lite|heavy | --weights FILE]\n"
+    "usage: ampi bench network --input RGB.npy [--model NAME | --weights FILE]\n"
     "                          [--threads LIST] [--runs N] [--warmup N] [--save PREFIX]\n"
     "\n"
-    "Times DepthNet::run on one image: RGB.npy holds H x W x 3 float32 values in [0, 1]\n"
+    "Times DepthModel::run on one image: RGB.npy holds H x W x 3 float32 values in [0, 1]\n"
     "(any H and W; the network pads them to its multiple and crops the output back).\n"
     "For each thread count, runs N times after the warm-up runs and prints one line:\n"
     "  {\"engine\": \"ampi\", \"model\": ..., \"isa\": ..., \"threads\": T, \"ms\": [...]}\n"
     "bench/peers/run.sh uses it to compare ampi with ONNX Runtime, OpenCV DNN and PyTorch.\n"
     "\n"
-    "  --model NAME     bundled weights, lite (default) or heavy\n"
+    "  --model NAME     a bundled depth model by name: lite (default), heavy, ...\n"
     "  --weights FILE   a depth weight file instead\n"
     "  --threads LIST   comma-separated thread counts (default 1,2)\n"
     "  --runs N         timed runs per thread count (default 5)\n"
@@ -65,7 +65,7 @@ Tensor read_rgb(const std::string& path) {
   return rgb;
 }
 
-std::vector<double> time_runs(DepthNet& net, const Tensor& rgb, ThreadPool& pool, int warmup, int runs,
+std::vector<double> time_runs(DepthModel& net, const Tensor& rgb, ThreadPool& pool, int warmup, int runs,
                               Tensor* last_output) {
   const int h = static_cast<int>(rgb.dim(0)), w = static_cast<int>(rgb.dim(1));
   for (int i = 0; i < warmup; ++i) *last_output = net.run(rgb.f32(), h, w, pool);
@@ -98,18 +98,15 @@ int network_benchmark(int argc, char** argv) {
   p.option("--save", &save);
   if (!p.parse(argc, argv)) return 0;
   if (input.empty()) throw std::runtime_error("network: --input RGB.npy is required");
-  if (model != "lite" && model != "heavy")
-    throw std::runtime_error("network: --model must be lite or heavy, not '" + model + "'");
   const std::vector<int> thread_counts = parse_thread_list(threads_text);
-  if (weights.empty()) weights = find_weights("depth_" + model + ".ampw");
 
   const Tensor rgb = read_rgb(input);
-  DepthNet net = DepthNet::load(weights);
+  const std::unique_ptr<DepthModel> net = load_depth_model(depth_weights_path(weights, model));
   for (int threads : thread_counts) {
     ThreadPool pool(threads);
     Tensor output;
-    const std::vector<double> ms = time_runs(net, rgb, pool, warmup, runs, &output);
-    std::printf("%s\n", json_line(net.variant(), threads, ms).c_str());
+    const std::vector<double> ms = time_runs(*net, rgb, pool, warmup, runs, &output);
+    std::printf("%s\n", json_line(net->variant(), threads, ms).c_str());
     std::fflush(stdout);
     if (!save.empty()) write_npy(save + ".t" + std::to_string(threads) + ".npy", output);
   }

@@ -19,8 +19,8 @@
 #include "cli/args.h"
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
-#include "nets/depth_net.h"
-#include "nets/weights_path.h"
+#include "nets/model_loader.h"
+#include "nets/bundled_weights.h"
 #include "pipeline/depth_estimate.h"
 #include "pipeline/full_resolution.h"
 #include "pipeline/make_mpi.h"
@@ -156,18 +156,16 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
 // for the first time after the heap was handed back (page faults), while the network's
 // arena persists, and the depth stage includes shrinking the photo.
 void measure_slicing_share(const cv::Mat& source, const MpiOptions& options, int reps, SizeResult& r) {
-  DepthNet net = DepthNet::load(options.depth_weights.empty()
-                                    ? find_weights("depth_" + options.depth_model + ".ampw")
-                                    : options.depth_weights);
-  const int side = options.working_size ? options.working_size : net.working_long_side();
+  const std::unique_ptr<DepthModel> net = load_depth_model(depth_weights_path(options.depth_weights, options.depth_model));
+  const int side = options.working_size ? options.working_size : net->working_long_side();
   cv::Mat photo, small;
   cv::resize(source, photo, r.size, 0, 0, cv::INTER_AREA);
   const ImageSize work = depth_working_size(photo.rows, photo.cols, side);
   cv::resize(photo, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
-  cv::Mat disparity = estimate_disparity(net, small, side);
+  cv::Mat disparity = estimate_disparity(*net, small, side);
   std::vector<double> network_ms, slicing_ms;
   for (int k = 0; k <= reps; ++k) {  // k = 0 warms up
-    const double network = time_ms([&] { disparity = estimate_disparity(net, small, side); });
+    const double network = time_ms([&] { disparity = estimate_disparity(*net, small, side); });
     const double slicing = time_ms([&] { slice_adaptive(disparity, options.slicing); });
     if (k == 0) continue;
     network_ms.push_back(network);

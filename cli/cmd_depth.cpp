@@ -1,15 +1,16 @@
 // ampi depth PHOTO -o FILE.png: the depth network on one photo, a 16-bit disparity PNG out.
 #include <chrono>
 #include <cstdio>
-#include <cstdlib>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <opencv2/imgproc.hpp>
 
+#include "cli/args.h"
 #include "cli/commands.h"
-#include "nets/depth_net.h"
-#include "nets/weights_path.h"
+#include "nets/bundled_weights.h"
+#include "nets/model_loader.h"
 #include "pipeline/depth_estimate.h"
 #include "pipeline/depth_io.h"
 #include "pipeline/photo_io.h"
@@ -18,7 +19,7 @@ namespace ampi::cli {
 namespace {
 
 const char kUsage[] =
-    "usage: ampi depth PHOTO -o FILE.png [--model lite|heavy] [--weights FILE]\n"
+    "usage: ampi depth PHOTO -o FILE.png [--model NAME] [--weights FILE]\n"
     "                  [--max-size N] [--threads N]\n"
     "\n"
     "Estimates the photo's disparity (relative inverse depth) with the depth network and\n"
@@ -27,9 +28,10 @@ const char kUsage[] =
     "is at most --max-size (never up), run through the network, and the map resized back.\n"
     "\n"
     "  -o FILE.png       the disparity map to write (replaced atomically)\n"
-    "  --model M         lite (default, faster) or heavy (more accurate)\n"
-    "  --weights FILE    a depth weight file instead of the bundled weights/depth_M.ampw\n"
-    "                    (found via $AMPI_WEIGHTS_DIR or weights/ beside the program)\n"
+    "  --model NAME      a bundled depth model by name (the depth.variant of a file in\n"
+    "                    $AMPI_WEIGHTS_DIR or weights/ beside the program): lite (default,\n"
+    "                    faster) or heavy (more accurate)\n"
+    "  --weights FILE    a depth weight file of any depth architecture instead\n"
     "  --max-size N      working resolution: long side in pixels (default: what the\n"
     "                    weight file asks for, depth.working_long_side, else 1024)\n"
     "  --threads N       worker threads (default: all hardware threads)\n";
@@ -40,49 +42,31 @@ struct DepthOptions {
   int threads = 0;
 };
 
-int parse_positive(const std::string& option, const char* text, int max) {
-  char* end = nullptr;
-  const long n = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || n < 1 || n > max)
-    throw std::runtime_error(option + ": '" + text + "' is not a number in 1.." + std::to_string(max));
-  return static_cast<int>(n);
-}
-
-DepthOptions parse(int argc, char** argv) {
+DepthOptions parse(int argc, char** argv, bool& help) {
   DepthOptions o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    auto value = [&]() -> const char* {
-      if (i + 1 >= argc) throw std::runtime_error(arg + " needs a value (see ampi depth --help)");
-      return argv[++i];
-    };
-    if (arg == "-o" || arg == "--output") {
-      o.output = value();
-    } else if (arg == "--model") {
-      o.model = value();
-      if (o.model != "lite" && o.model != "heavy")
-        throw std::runtime_error("--model: '" + o.model + "' is not lite or heavy");
-    } else if (arg == "--weights") {
-      o.weights = value();
-    } else if (arg == "--max-size") {
-      o.max_size = parse_positive(arg, value(), 16384);
-    } else if (arg == "--threads") {
-      o.threads = parse_positive(arg, value(), 1024);
-    } else if (arg.size() > 1 && arg[0] == '-') {
-      throw std::runtime_error("unknown option '" + arg + "' (see ampi depth --help)");
-    } else if (o.photo.empty()) {
-      o.photo = arg;
-    } else {
-      throw std::runtime_error("one photo only; also got '" + arg + "'");
-    }
-  }
-  if (o.photo.empty()) throw std::runtime_error("missing PHOTO (see ampi depth --help)");
+  std::vector<std::string> photos;
+  ArgParser p("depth", kUsage);
+  p.option("-o", &o.output);
+  p.option("--output", &o.output);
+  p.option("--model", [&](const std::string& v) {
+    check_depth_model_name(v);
+    o.model = v;
+  });
+  p.option("--weights", &o.weights);
+  p.option("--max-size", &o.max_size, 1, 16384);
+  p.option("--threads", &o.threads, 1, 1024);
+  p.positionals(&photos);
+  help = !p.parse(argc, argv);
+  if (help) return o;
+  if (photos.empty()) throw std::runtime_error("missing PHOTO (see ampi depth --help)");
+  if (photos.size() > 1) throw std::runtime_error("one photo only; also got '" + photos[1] + "'");
   if (o.output.empty()) throw std::runtime_error("missing -o FILE.png (see ampi depth --help)");
+  o.photo = photos[0];
   return o;
 }
 
 // The network's map at the working resolution, brought back to the photo's size.
-cv::Mat disparity_at_photo_size(DepthNet& net, const cv::Mat& bgr, int max_size, ThreadPool& pool) {
+cv::Mat disparity_at_photo_size(DepthModel& net, const cv::Mat& bgr, int max_size, ThreadPool& pool) {
   const cv::Mat work = estimate_disparity(net, bgr, max_size, pool);
   if (work.size() == bgr.size()) return work;
   cv::Mat full;
@@ -93,23 +77,20 @@ cv::Mat disparity_at_photo_size(DepthNet& net, const cv::Mat& bgr, int max_size,
 }  // namespace
 
 int cmd_depth(int argc, char** argv) {
-  if (argc >= 2 && (std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h")) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
-  const DepthOptions o = parse(argc, argv);
-  const std::string weights = o.weights.empty() ? find_weights("depth_" + o.model + ".ampw") : o.weights;
-  DepthNet net = DepthNet::load(weights);
-  const int max_size = o.max_size ? o.max_size : net.working_long_side();
+  bool help = false;
+  const DepthOptions o = parse(argc, argv, help);
+  if (help) return 0;
+  const std::unique_ptr<DepthModel> net = load_depth_model(depth_weights_path(o.weights, o.model));
+  const int max_size = o.max_size ? o.max_size : net->working_long_side();
   const cv::Mat photo = read_photo(o.photo);
   ThreadPool pool(o.threads);
   const auto start = std::chrono::steady_clock::now();
-  const cv::Mat disparity = disparity_at_photo_size(net, photo, max_size, pool);
+  const cv::Mat disparity = disparity_at_photo_size(*net, photo, max_size, pool);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_depth_png16(disparity, o.output);
   const ImageSize work = depth_working_size(photo.rows, photo.cols, max_size);
   std::printf("%s: %dx%d disparity (%s network at %dx%d, %.2f s) -> %s\n", o.photo.c_str(), photo.cols,
-              photo.rows, net.variant().c_str(), work.width, work.height, seconds, o.output.c_str());
+              photo.rows, net->variant().c_str(), work.width, work.height, seconds, o.output.c_str());
   return 0;
 }
 

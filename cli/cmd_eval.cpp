@@ -21,9 +21,9 @@
 #include "eval/ordinal_eval.h"
 #include "eval/slicing_eval.h"
 #include "inpaint/eval_inpaint.h"
-#include "inpaint/inpaint_net.h"
-#include "nets/depth_net.h"
-#include "nets/weights_path.h"
+#include "inpaint/net_filler.h"
+#include "nets/bundled_weights.h"
+#include "nets/model_loader.h"
 #include "pipeline/depth_estimate.h"
 #include "pipeline/depth_io.h"
 #include "pipeline/photo_io.h"
@@ -68,11 +68,11 @@ struct InpaintEvalArgs {
 };
 
 // The depth network is required: without it there are no planes to evaluate on.
-DepthNet load_depth(const std::string& path) {
+std::unique_ptr<DepthModel> load_depth(const std::string& path) {
   std::string file = path;
   if (file.empty()) {
     try {
-      file = find_weights("depth_lite.ampw");
+      file = depth_weights_path({}, "lite");
     } catch (const std::exception& e) {
       throw std::runtime_error(
           std::string("the depth network is needed to slice the photos (or give --depth-weights FILE "
@@ -83,7 +83,7 @@ DepthNet load_depth(const std::string& path) {
   if (info.has("train.steps") && info.get_int("train.steps") == 0)
     std::fprintf(stderr, "note: %s is untrained (train.steps = 0): planes follow its arbitrary output\n",
                  file.c_str());
-  return DepthNet::load(file);
+  return load_depth_model(info);
 }
 
 // The map of images/sub/photo.jpg is depth_dir/sub/photo.jpg.png.
@@ -125,10 +125,9 @@ int eval_inpaint(int argc, char** argv) {
 
   std::vector<std::string> photos = list_images(a.images);
   if (a.limit > 0 && size_t(a.limit) < photos.size()) photos.resize(a.limit);
-  std::optional<DepthNet> depth;
-  if (a.depth_dir.empty()) depth.emplace(load_depth(a.depth_weights));
-  auto net = std::make_shared<const InpaintNet>(
-      InpaintNet::load(a.weights.empty() ? find_weights("inpaint.ampw") : a.weights));
+  std::unique_ptr<DepthModel> depth;
+  if (a.depth_dir.empty()) depth = load_depth(a.depth_weights);
+  auto net = std::make_shared<const InpaintNet>(load_inpaint_net(inpaint_weights_path(a.weights)));
   InpaintEvaluator eval({{"ampi", network_filler(net)},
                          {"telea", telea_filler(a.radius)},
                          {"ns", navier_stokes_filler(a.radius)},
@@ -152,7 +151,7 @@ int eval_inpaint(int argc, char** argv) {
 // ---- eval depth ------------------------------------------------------------------------------
 
 const char kDepthUsage[] =
-    "usage: ampi eval depth --images DIR --reference DIR [--model lite|heavy | --weights FILE]\n"
+    "usage: ampi eval depth --images DIR --reference DIR [--model NAME | --weights FILE]\n"
     "                       [--reference-is-distance] [--working-size N] [--limit N] [--threads N]\n"
     "       ampi eval depth --images DIR --ordinal FILE [--split val|train|all] [...]\n"
     "\n"
@@ -186,7 +185,7 @@ const char kDepthUsage[] =
     "  --reference-is-distance   the references hold distances (larger = farther); 0 = none\n"
     "  --ordinal FILE            an ordinal set instead of reference maps (WHDR)\n"
     "  --split S                 the ordinal set's photos scored: val (default), train or all\n"
-    "  --model M                 lite (default) or heavy: the bundled weights/depth_M.ampw\n"
+    "  --model M                 a bundled depth model by name: lite (default), heavy\n"
     "  --weights FILE            a depth weight file instead\n"
     "  --working-size N          long side the network runs at (default: the weight file's)\n"
     "  --limit N                 only the first N photos\n"
@@ -204,8 +203,8 @@ void print_depth_row(const std::string& method, const DepthMetrics& m, int image
 }
 
 // --weights FILE, or the bundled file of --model.
-DepthNet load_depth_net(const DepthEvalArgs& a) {
-  return DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights);
+std::unique_ptr<DepthModel> load_depth_net(const DepthEvalArgs& a) {
+  return load_depth_model(depth_weights_path(a.weights, a.model));
 }
 
 void print_ordinal_row(const std::string& method, const OrdinalScore& s, int photos) {
@@ -224,8 +223,8 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
   for (const OrdinalPhoto& e : set)  // a missing photo stops before the network runs
     if (!fs::is_regular_file(fs::path(a.images) / e.photo))
       throw std::runtime_error((fs::path(a.images) / e.photo).string() + ": photo of the ordinal set not found");
-  DepthNet net = load_depth_net(a);
-  const int side = a.working_size ? a.working_size : net.working_long_side();
+  const std::unique_ptr<DepthModel> net = load_depth_net(a);
+  const int side = a.working_size ? a.working_size : net->working_long_side();
   OrdinalScore network, gradient, constant;
   for (const OrdinalPhoto& e : set) {
     const std::string path = (fs::path(a.images) / e.photo).string();
@@ -234,7 +233,7 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
       throw std::runtime_error(path + ": is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
                                " but was labelled at " + std::to_string(e.size.width) + "x" +
                                std::to_string(e.size.height));
-    const OrdinalScore s = score_ordinal(estimate_disparity(net, bgr, side), e);
+    const OrdinalScore s = score_ordinal(estimate_disparity(*net, bgr, side), e);
     network.add(s);
     gradient.add(score_ordinal(vertical_gradient_disparity(e.size), e));
     constant.add(score_ordinal(cv::Mat(e.size, CV_32FC1, cv::Scalar(1)), e));
@@ -262,7 +261,7 @@ int eval_depth(int argc, char** argv) {
     a.split = v;
   });
   p.option("--model", [&](const std::string& v) {
-    if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
+    check_depth_model_name(v);
     a.model = v;
   });
   p.option("--weights", &a.weights);
@@ -281,8 +280,8 @@ int eval_depth(int argc, char** argv) {
   // Every reference is looked up before the network runs: a missing one stops at once.
   std::vector<std::string> references;
   for (const std::string& photo : photos) references.push_back(find_depth_reference(photo, a.images, a.reference));
-  DepthNet net = load_depth_net(a);
-  const int side = a.working_size ? a.working_size : net.working_long_side();
+  const std::unique_ptr<DepthModel> net = load_depth_net(a);
+  const int side = a.working_size ? a.working_size : net->working_long_side();
   DepthMetricsMean network, gradient;
   for (size_t i = 0; i < photos.size(); ++i) {
     const cv::Mat bgr = read_photo(photos[i]);
@@ -292,7 +291,7 @@ int eval_depth(int argc, char** argv) {
                    photos[i].c_str(), bgr.cols, bgr.rows, references[i].c_str(), ref.disparity.cols,
                    ref.disparity.rows);
     cv::Mat prediction;
-    cv::resize(estimate_disparity(net, bgr, side), prediction, ref.disparity.size(), 0, 0, cv::INTER_LINEAR);
+    cv::resize(estimate_disparity(*net, bgr, side), prediction, ref.disparity.size(), 0, 0, cv::INTER_LINEAR);
     const DepthMetrics m = depth_metrics(prediction, ref);
     network.add(m);
     gradient.add(depth_metrics(vertical_gradient_disparity(ref.disparity.size()), ref));
@@ -312,7 +311,7 @@ int eval_depth(int argc, char** argv) {
 
 const char kSlicingUsage[] =
     "usage: ampi eval slicing --images DIR [--counts 4,8,16] [--reference-planes N] [--poses N]\n"
-    "                         [--amplitude A] [--max-size N] [--model lite|heavy | --weights FILE]\n"
+    "                         [--amplitude A] [--max-size N] [--model NAME | --weights FILE]\n"
     "                         [--working-size N] [--depth-dir D] [--inpainter push-pull|network]\n"
     "                         [--slicer paper|optimal] [--min-plane-share F] [--tear-penalty P]\n"
     "                         [--no-edge-snap] [--limit N] [--threads N]\n"
@@ -366,7 +365,7 @@ struct SlicingEvalArgs {
 
 LayerFiller slicing_filler(const std::string& inpainter) {
   if (inpainter == "push-pull") return push_pull_filler();
-  return inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(find_weights("inpaint.ampw"))));
+  return inpaint_net_filler(std::make_shared<const InpaintNet>(load_inpaint_net(inpaint_weights_path())));
 }
 
 void print_slicing_table(const std::vector<SlicingScore>& rows, const std::vector<int>& psnr_wins,
@@ -396,7 +395,7 @@ int eval_slicing(int argc, char** argv) {
   p.option("--amplitude", &a.options.amplitude, 1e-6, 0.999);
   p.option("--max-size", &a.max_size, 32, 16384);
   p.option("--model", [&](const std::string& v) {
-    if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
+    check_depth_model_name(v);
     a.model = v;
   });
   p.option("--weights", &a.weights);
@@ -423,9 +422,8 @@ int eval_slicing(int argc, char** argv) {
     if (!fs::is_directory(a.depth_dir)) throw std::runtime_error(a.depth_dir + ": not a directory");
     for (const std::string& photo : photos) depth_maps.push_back(find_depth_reference(photo, a.images, a.depth_dir));
   }
-  std::optional<DepthNet> net;
-  if (depth_maps.empty())
-    net.emplace(DepthNet::load(a.weights.empty() ? find_weights("depth_" + a.model + ".ampw") : a.weights));
+  std::unique_ptr<DepthModel> net;
+  if (depth_maps.empty()) net = load_depth_model(depth_weights_path(a.weights, a.model));
   const int side = a.working_size ? a.working_size : net ? net->working_long_side() : 0;
   SlicingEvaluator eval(a.options, slicing_filler(a.inpainter));
   std::vector<int> psnr_wins(a.options.counts.size()), ssim_wins(a.options.counts.size());

@@ -14,8 +14,8 @@
 #include "engine/thread_pool.h"
 #include "eval/depth_eval.h"
 #include "eval/edge_eval.h"
-#include "nets/depth_net.h"
-#include "nets/weights_path.h"
+#include "nets/bundled_weights.h"
+#include "nets/model_loader.h"
 #include "pipeline/depth_estimate.h"
 #include "pipeline/depth_io.h"
 #include "pipeline/make_mpi.h"
@@ -199,8 +199,8 @@ int eval_photos(const EdgeEvalArgs& a) {
   if (!a.depth_dir.empty())
     for (const std::string& photo : photos) maps.push_back(find_depth_reference(photo, a.images, a.depth_dir));
   // Without maps, the bundled lite network at its working size, as ampi run uses it.
-  std::optional<DepthNet> net;
-  if (maps.empty()) net.emplace(DepthNet::load(find_weights("depth_lite.ampw")));
+  std::unique_ptr<DepthModel> net;
+  if (maps.empty()) net = load_depth_model(depth_weights_path({}, "lite"));
   fs::create_directories(a.output);
   const Pose pose = pose_of(a.poses[0]);
   for (size_t i = 0; i < photos.size(); ++i) {

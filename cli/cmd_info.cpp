@@ -3,11 +3,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdio>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "cli/args.h"
 #include "cli/commands.h"
 #include "weights_format/weight_file.h"
 
@@ -63,15 +63,12 @@ void print_info(const WeightFile& wf) {
 }  // namespace
 
 int cmd_info(int argc, char** argv) {
-  if (argc == 2 && (!std::strcmp(argv[1], "--help") || !std::strcmp(argv[1], "-h"))) {
-    std::fputs(kUsage, stdout);
-    return 0;
-  }
-  if (argc != 2 || argv[1][0] == '-') {
-    std::fputs("ampi info: expected one weight file (usage: ampi info FILE.ampw)\n", stderr);
-    return 2;
-  }
-  print_info(WeightFile::open(argv[1]));
+  std::vector<std::string> files;
+  ArgParser p("info", kUsage);
+  p.positionals(&files);
+  if (!p.parse(argc, argv)) return 0;
+  if (files.size() != 1) throw std::runtime_error("expected one weight file (usage: ampi info FILE.ampw)");
+  print_info(WeightFile::open(files[0]));
   return 0;
 }
 

@@ -12,6 +12,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "nets/bundled_weights.h"
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
 #include "pipeline/depth_io.h"
@@ -42,7 +43,7 @@ const char kUsage[] =
     "  -o, --output DIR        where to write (refused if it exists, unless --force)\n"
     "  --force                 replace ampi's own outputs in an existing DIR (nothing else\n"
     "                          in it is touched)\n"
-    "  --model lite|heavy      bundled depth network (default lite)\n"
+    "  --model NAME            bundled depth network by name: lite (default), heavy\n"
     "  --weights FILE          depth network weight file instead of the bundled one\n"
     "  --depth FILE            your own depth map instead of the network (one photo only):\n"
     "                          8/16-bit PNG, float TIFF or .npy, the photo's size\n"
@@ -103,7 +104,7 @@ RunArgs parse(int argc, char** argv, bool& help) {
   p.flag("--quiet", &a.quiet);
   p.option("--threads", &a.threads, 1, 256);
   p.option("--model", [&](const std::string& v) {
-    if (v != "lite" && v != "heavy") throw std::runtime_error("--model: '" + v + "' is not lite or heavy");
+    check_depth_model_name(v);
     a.mpi.depth_model = v;
   });
   p.option("--weights", &a.mpi.depth_weights);

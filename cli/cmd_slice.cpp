@@ -1,10 +1,10 @@
 // ampi slice DEPTH: the planes slicing cuts a depth map into, as JSON on stdout.
 #include <cstdio>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "cli/args.h"
 #include "cli/commands.h"
 #include "pipeline/depth_io.h"
 #include "slicing/adaptive.h"
@@ -49,55 +49,22 @@ struct SliceOptions {
   bool depth_is_distance = false;
 };
 
-int parse_plane_count(const char* text) {
-  char* end = nullptr;
-  const long n = std::strtol(text, &end, 10);
-  if (end == text || *end != '\0' || n < 1 || n > kDisparityLevels - 1)
-    throw std::runtime_error(std::string("--max-planes: '") + text + "' is not a number in 1..255");
-  return static_cast<int>(n);
-}
-
-// `text` as a number in [lo, hi], else a runtime_error naming `option`.
-double parse_number(const char* option, const char* text, double lo, double hi) {
-  char* end = nullptr;
-  const double f = std::strtod(text, &end);
-  if (end == text || *end != '\0' || !(f >= lo && f <= hi)) {
-    char range[64];
-    std::snprintf(range, sizeof range, "%g..%g", lo, hi);
-    throw std::runtime_error(std::string(option) + ": '" + text + "' is not a number in " + range);
-  }
-  return f;
-}
-
-SliceOptions parse(int argc, char** argv) {
+SliceOptions parse(int argc, char** argv, bool& help) {
   SliceOptions o;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--max-planes") {
-      if (i + 1 >= argc) throw std::runtime_error("--max-planes needs a number");
-      o.max_planes = parse_plane_count(argv[++i]);
-    } else if (arg == "--min-plane-share") {
-      if (i + 1 >= argc) throw std::runtime_error("--min-plane-share needs a number");
-      o.min_plane_share = parse_number("--min-plane-share", argv[++i], 0, 1);
-    } else if (arg == "--tear-penalty") {
-      if (i + 1 >= argc) throw std::runtime_error("--tear-penalty needs a number");
-      o.tear_penalty = parse_number("--tear-penalty", argv[++i], 0, 1e9);
-    } else if (arg == "--slicer") {
-      if (i + 1 >= argc) throw std::runtime_error("--slicer needs paper or optimal");
-      o.slicer = parse_slicer(argv[++i]);
-    } else if (arg == "--uniform") {
-      o.uniform = true;
-    } else if (arg == "--depth-is-distance") {
-      o.depth_is_distance = true;
-    } else if (arg.size() > 1 && arg[0] == '-') {
-      throw std::runtime_error("unknown option '" + arg + "' (see ampi slice --help)");
-    } else if (o.depth_path.empty()) {
-      o.depth_path = arg;
-    } else {
-      throw std::runtime_error("one depth map only; also got '" + arg + "'");
-    }
-  }
-  if (o.depth_path.empty()) throw std::runtime_error("missing DEPTH (see ampi slice --help)");
+  std::vector<std::string> maps;
+  ArgParser p("slice", kUsage);
+  p.option("--max-planes", &o.max_planes, 1, kDisparityLevels - 1);
+  p.option("--min-plane-share", &o.min_plane_share, 0, 1);
+  p.option("--tear-penalty", &o.tear_penalty, 0, 1e9);
+  p.option("--slicer", [&](const std::string& v) { o.slicer = parse_slicer(v); });
+  p.flag("--uniform", &o.uniform);
+  p.flag("--depth-is-distance", &o.depth_is_distance);
+  p.positionals(&maps);
+  help = !p.parse(argc, argv);
+  if (help) return o;
+  if (maps.empty()) throw std::runtime_error("missing DEPTH (see ampi slice --help)");
+  if (maps.size() > 1) throw std::runtime_error("one depth map only; also got '" + maps[1] + "'");
+  o.depth_path = maps[0];
   return o;
 }
 
@@ -114,12 +81,9 @@ void print_planes(const std::vector<Plane>& planes) {
 }  // namespace
 
 int cmd_slice(int argc, char** argv) {
-  for (int i = 1; i < argc; ++i)
-    if (!std::strcmp(argv[i], "--help") || !std::strcmp(argv[i], "-h")) {
-      std::fputs(kUsage, stdout);
-      return 0;
-    }
-  const SliceOptions o = parse(argc, argv);
+  bool help = false;
+  const SliceOptions o = parse(argc, argv, help);
+  if (help) return 0;
   const cv::Mat disparity = read_depth_map(o.depth_path, o.depth_is_distance);
   SlicingParams params;
   params.max_planes = o.max_planes;

@@ -2,21 +2,20 @@
 
 #include <algorithm>
 #include <cmath>
-#include <functional>
 #include <memory>
 #include <optional>
 #include <stdexcept>
 
-#include "engine/arena.h"
 #include "kernels/conv.h"
 #include "kernels/inverted_residual.h"
 #include "kernels/ops.h"
+#include "nets/architectures.h"
+#include "nets/plan.h"
 #include "weights_format/weight_file.h"
 
 namespace ampi {
 namespace {
 
-constexpr const char* kArchName = "ampi.depth.dwt-mobilenetv3";
 constexpr int64_t kFormatVersion = 1;
 constexpr int kFieldsPerBlock = 6;  // kind, out, expanded, kernel, se_reduced, activation
 constexpr int kMaxLevels = 8;
@@ -167,65 +166,7 @@ Stage load_stage(const WeightFile& f, const std::string& key, const std::string&
 
 int out_channels(const Stage& s) { return s.back().spec.out_c; }
 
-// ---- execution plan -----------------------------------------------------------------------
-
-// The network unrolled for one padded input size: a list of steps, each reading and
-// writing activation values that live in one arena. A value's lifetime runs from the step
-// that writes it to the last step that reads it; the arena lets values whose lifetimes do
-// not overlap share bytes, and never places a step's output over one of its inputs.
-class Plan {
- public:
-  struct Value {
-    int h, w, c;
-    int first, last;
-    int arena_id = -1;
-  };
-  using Step = std::function<void(Plan&, ThreadPool&)>;
-
-  // Declares the value the next pushed step writes.
-  int produce(int h, int w, int c) {
-    const int now = static_cast<int>(steps_.size());
-    values_.push_back({h, w, c, now, now});
-    return static_cast<int>(values_.size()) - 1;
-  }
-  // Marks `v` as read by the next pushed step.
-  void consume(int v) { values_.at(v).last = std::max(values_[v].last, int(steps_.size())); }
-  void push(Step step) { steps_.push_back(std::move(step)); }
-  const Value& value(int v) const { return values_.at(v); }
-
-  // `owner` names the network in a memory-budget error.
-  void allocate(const std::string& owner) {
-    for (Value& v : values_)
-      v.arena_id = arena_.request(size_t(v.h) * v.w * v.c * sizeof(float), v.first, v.last);
-    arena_.plan(owner);
-  }
-  float* data(int v) { return static_cast<float*>(arena_.data(values_[v].arena_id)); }
-  void execute(ThreadPool& pool) {
-    for (Step& s : steps_) s(*this, pool);
-  }
-  size_t arena_bytes() const { return arena_.total_bytes(); }
-
-  // What the first step reads: the caller's image, set before every execute().
-  const float* rgb = nullptr;
-  int rgb_h = 0, rgb_w = 0;
-  int output = -1;  // the value holding the padded full-resolution disparity
-
- private:
-  std::vector<Value> values_;
-  std::vector<Step> steps_;
-  Arena arena_;
-};
-
 }  // namespace
-
-ImageSize depth_working_size(int height, int width, int max_side) {
-  if (height <= 0 || width <= 0 || max_side <= 0)
-    throw std::invalid_argument("depth_working_size: sizes must be positive");
-  const int long_side = std::max(height, width);
-  if (long_side <= max_side) return {height, width};
-  const double scale = double(max_side) / long_side;
-  return {std::max(1, int(std::lround(height * scale))), std::max(1, int(std::lround(width * scale)))};
-}
 
 struct DepthNet::Impl {
   std::string variant;
@@ -238,20 +179,23 @@ struct DepthNet::Impl {
   const KernelTable* table = nullptr;
   std::unique_ptr<Plan> plan;
   int plan_h = 0, plan_w = 0;
+  int plan_output = -1;  // the value holding the padded full-resolution disparity
+  // What the plan's first step reads: the caller's image, set before every execute().
+  const float* rgb = nullptr;
+  int rgb_h = 0, rgb_w = 0;
 
   int multiple() const { return 1 << levels; }
-  std::unique_ptr<Plan> build_plan(int h, int w) const;
+  std::unique_ptr<Plan> build_plan(int h, int w);  // sets plan_output
   int add_stage(Plan& p, const Stage& stage, int x, int h, int w) const;
   int add_block(Plan& p, const Block& b, int x, int h, int w) const;
   // Block b on the channel concatenation of the maps up and skip (a decoder's first block).
   int add_concat_block(Plan& p, const Block& b, int up, int skip, int h, int w) const;
 };
 
-// Loads and checks everything the metadata promises before any weight is packed.
-DepthNet DepthNet::load(const std::string& path, const KernelTable& table) {
-  const WeightFile f = WeightFile::open(path);
-  if (f.get_string("arch") != kArchName)
-    fail(f, "architecture '" + f.get_string("arch") + "' is not a depth network (" + kArchName + ")");
+// Checks everything the metadata promises before any weight is packed.
+DepthNet DepthNet::from_file(const WeightFile& f, const KernelTable& table) {
+  if (f.get_string("arch") != arch::kDepthDwtMobileNetV3)
+    fail(f, "architecture '" + f.get_string("arch") + "' is not " + arch::kDepthDwtMobileNetV3);
   if (f.get_int("depth.format_version") != kFormatVersion)
     fail(f, "depth.format_version " + std::to_string(f.get_int("depth.format_version")) +
                 " is not supported (this build reads " + std::to_string(kFormatVersion) + ")");
@@ -370,7 +314,7 @@ int DepthNet::Impl::add_stage(Plan& p, const Stage& stage, int x, int h, int w) 
   return x;
 }
 
-std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
+std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) {
   auto p = std::make_unique<Plan>();
   const KernelTable& k = *table;
   // The encoder: per stage a Haar DWT, then its blocks. The first DWT reads the caller's
@@ -382,7 +326,7 @@ std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
     const int d = p->produce(lh / 2, lw / 2, 4 * c);
     if (x < 0) {
       p->push([this, d, h, w](Plan& pl, ThreadPool& pool) {
-        normalise_and_dwt(pl.rgb, pl.rgb_h, pl.rgb_w, h, w, mean, inv_std, pl.data(d), pool);
+        normalise_and_dwt(rgb, rgb_h, rgb_w, h, w, mean, inv_std, pl.data(d), pool);
       });
     } else {
       p->consume(x);
@@ -412,7 +356,7 @@ std::unique_ptr<Plan> DepthNet::Impl::build_plan(int h, int w) const {
   const int out = p->produce(h, w, 1);
   p->consume(coeffs);
   p->push([&k, coeffs, out, lh, lw](Plan& pl, ThreadPool& pool) { haar_idwt(pl.data(coeffs), lh, lw, 1, pl.data(out), pool, k); });
-  p->output = out;
+  plan_output = out;
   p->allocate("depth network (" + variant + ") at " + std::to_string(w) + "x" + std::to_string(h));
   return p;
 }
@@ -427,12 +371,11 @@ Tensor DepthNet::run(const float* rgb, int h, int w, ThreadPool& pool) {
     m.plan_h = ph;
     m.plan_w = pw;
   }
-  Plan& p = *m.plan;
-  p.rgb = rgb;
-  p.rgb_h = h;
-  p.rgb_w = w;
-  p.execute(pool);
-  const float* full = p.data(p.output);  // crop the padding away
+  m.rgb = rgb;
+  m.rgb_h = h;
+  m.rgb_w = w;
+  m.plan->execute(pool);
+  const float* full = m.plan->data(m.plan_output);  // crop the padding away
   Tensor out = Tensor::empty({h, w});
   for (int y = 0; y < h; ++y) std::copy(full + size_t(y) * pw, full + size_t(y) * pw + w, out.f32() + size_t(y) * w);
   return out;
@@ -443,6 +386,10 @@ DepthNet::DepthNet(DepthNet&&) noexcept = default;
 DepthNet& DepthNet::operator=(DepthNet&&) noexcept = default;
 DepthNet::~DepthNet() = default;
 
+const std::string& DepthNet::architecture() const {
+  static const std::string name = arch::kDepthDwtMobileNetV3;
+  return name;
+}
 const std::string& DepthNet::variant() const { return impl_->variant; }
 int DepthNet::multiple() const { return impl_->multiple(); }
 int DepthNet::working_long_side() const { return impl_->working_long_side; }

@@ -1,20 +1,16 @@
-#include "inpaint/inpaint_net.h"
+#include "nets/inpaint_net.h"
 
 #include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
 
-#include <opencv2/imgproc.hpp>
-
-#include "inpaint/harmonic_fill.h"
-#include "inpaint/push_pull.h"
 #include "kernels/ops.h"
+#include "nets/architectures.h"
 
 namespace ampi {
 namespace {
 
-const char* const kModelName = "ampi-inpaint";
 constexpr int64_t kPlainVersion = 1;     // hole zeroed, output = tanh(last)
 constexpr int64_t kResidualVersion = 2;  // hole pre-filled (inpaint.prefill), output = rgb + hole * tanh(last)
 
@@ -127,13 +123,9 @@ ConvParams conv_params(const InpaintLayer& l, ActivationSpec act) {
 
 }  // namespace
 
-InpaintNet InpaintNet::load(const std::string& path, const KernelTable& k) {
-  return from_file(WeightFile::open(path), k);
-}
-
 InpaintNet InpaintNet::from_file(const WeightFile& f, const KernelTable& k) {
-  if (!f.has("model") || f.get_string("model") != kModelName)
-    fail(f, std::string("not an inpainting network (metadata 'model' is not '") + kModelName + "')");
+  if (f.get_string("arch") != arch::kInpaintGatedConv)
+    fail(f, "architecture '" + f.get_string("arch") + "' is not " + arch::kInpaintGatedConv);
   const int64_t version = f.get_int("inpaint.version");
   if (version != kPlainVersion && version != kResidualVersion)
     fail(f, "inpaint.version " + std::to_string(version) + " is not supported");
@@ -154,10 +146,6 @@ InpaintNet InpaintNet::from_file(const WeightFile& f, const KernelTable& k) {
     const Tensor b = f.tensor(l.name + ".bias", {p.out_c});
     net.convs_.emplace_back(p, w.f32(), b.f32(), k);
   }
-  net.last_use_.assign(net.layers_.size(), -1);
-  for (size_t i = 0; i < net.layers_.size(); ++i)
-    for (int ref : {net.layers_[i].source, net.layers_[i].skip})
-      if (ref >= 0) net.last_use_[ref] = int(i);
   return net;
 }
 
@@ -175,171 +163,71 @@ void InpaintNet::run(const float* rgb, const float* hole, int h, int w, float* o
     throw std::invalid_argument("inpaint net: input " + std::to_string(h) + "x" + std::to_string(w) +
                                 " is not a positive multiple of " + std::to_string(multiple_));
   const int64_t pixels = int64_t(h) * w;
-  std::vector<float> x(pixels * kInChannels);
-  for (int64_t p = 0; p < pixels; ++p) {
-    const float keep = prefill_ != Prefill::None ? 1.0f : 1.0f - hole[p];
-    for (int c = 0; c < 3; ++c) x[p * kInChannels + c] = rgb[p * 3 + c] * keep;
-    x[p * kInChannels + 3] = hole[p];
-  }
-  std::vector<std::vector<float>> outs(layers_.size());
+  const bool residual = prefill_ != Prefill::None;
+  Plan plan;
+  const int input = plan.produce(h, w, kInChannels);
+  plan.push([=](Plan& pl, ThreadPool&) {
+    float* x = pl.data(input);
+    for (int64_t p = 0; p < pixels; ++p) {
+      const float keep = residual ? 1.0f : 1.0f - hole[p];
+      for (int c = 0; c < 3; ++c) x[p * kInChannels + c] = rgb[p * 3 + c] * keep;
+      x[p * kInChannels + 3] = hole[p];
+    }
+  });
+  std::vector<int> outs(layers_.size(), -1);
   for (size_t i = 0; i < layers_.size(); ++i) {
     const InpaintLayer& l = layers_[i];
-    std::vector<float> scratch;
-    const float* in = layer_input(int(i), outs, x, h, w, scratch, pool);
-    const int in_h = h >> (l.scale_log2 - (l.stride == 2 ? 1 : 0));
-    const int in_w = w >> (l.scale_log2 - (l.stride == 2 ? 1 : 0));
-    const int64_t out_pixels = int64_t(h >> l.scale_log2) * (w >> l.scale_log2);
-    const bool last = i + 1 == layers_.size();
-    if (l.gated) {
-      std::vector<float> raw(out_pixels * 2 * l.out_c);
-      convs_[i].run(in, in_h, in_w, raw.data(), nullptr, pool);
-      outs[i].resize(out_pixels * l.out_c);
-      gated_output(raw.data(), out_pixels, l.out_c, feature_act_, outs[i].data(), pool, *k_);
-    } else if (last) {
-      convs_[i].run(in, in_h, in_w, out, nullptr, pool);
+    const Conv2d& conv = convs_[i];
+    const int in = add_layer_input(plan, int(i), outs, input);
+    const int in_h = plan.value(in).h, in_w = plan.value(in).w;
+    const int out_h = h >> l.scale_log2, out_w = w >> l.scale_log2;
+    plan.consume(in);
+    if (i + 1 == layers_.size()) {  // check_graph: a plain full-resolution layer
+      plan.push([&conv, in, in_h, in_w, out](Plan& pl, ThreadPool& tp) { conv.run(pl.data(in), in_h, in_w, out, nullptr, tp); });
+    } else if (l.gated) {
+      const int raw = plan.produce(out_h, out_w, 2 * l.out_c);
+      plan.push([&conv, in, in_h, in_w, raw](Plan& pl, ThreadPool& tp) { conv.run(pl.data(in), in_h, in_w, pl.data(raw), nullptr, tp); });
+      outs[i] = plan.produce(out_h, out_w, l.out_c);
+      plan.consume(raw);
+      const int64_t out_pixels = int64_t(out_h) * out_w;
+      plan.push([this, raw, out_pixels, c = l.out_c, y = outs[i]](Plan& pl, ThreadPool& tp) {
+        gated_output(pl.data(raw), out_pixels, c, feature_act_, pl.data(y), tp, *k_);
+      });
     } else {
-      outs[i].resize(out_pixels * l.out_c);
-      convs_[i].run(in, in_h, in_w, outs[i].data(), nullptr, pool);
+      outs[i] = plan.produce(out_h, out_w, l.out_c);
+      plan.push([&conv, in, in_h, in_w, y = outs[i]](Plan& pl, ThreadPool& tp) { conv.run(pl.data(in), in_h, in_w, pl.data(y), nullptr, tp); });
     }
-    // free what no later layer reads, so the peak is a few layers, not the whole net
-    for (int ref : {l.source, l.skip})
-      if (ref >= 0 && last_use_[ref] == int(i)) std::vector<float>().swap(outs[ref]);
   }
-  if (prefill_ != Prefill::None)  // the tanh output is a correction of the pre-filled hole
+  plan.allocate("inpainting network at " + std::to_string(w) + "x" + std::to_string(h));
+  plan.execute(pool);
+  if (residual)  // the tanh output is a correction of the pre-filled hole
     for (int64_t p = 0; p < pixels; ++p)
       for (int c = 0; c < 3; ++c) out[p * 3 + c] = rgb[p * 3 + c] + hole[p] * out[p * 3 + c];
 }
 
-// Layer i's convolution input: its source, up-sampled when asked, then its skip beside
-// it. Points into outs or x when neither applies, else into `scratch`.
-const float* InpaintNet::layer_input(int i, const std::vector<std::vector<float>>& outs,
-                                     const std::vector<float>& x, int h, int w,
-                                     std::vector<float>& scratch, ThreadPool& pool) const {
+int InpaintNet::add_layer_input(Plan& plan, int i, const std::vector<int>& outs, int input) const {
   const InpaintLayer& l = layers_[i];
-  const auto data = [&](int ref) { return ref == InpaintLayer::kInput ? x.data() : outs[ref].data(); };
-  const auto channels = [&](int ref) { return ref == InpaintLayer::kInput ? kInChannels : layers_[ref].out_c; };
-  const int src_scale = l.source == InpaintLayer::kInput ? 0 : layers_[l.source].scale_log2;
-  const int in_scale = src_scale - (l.upsample ? 1 : 0);
-  const int64_t pixels = int64_t(h >> in_scale) * (w >> in_scale);
-  const int ca = channels(l.source);
-  const float* in = data(l.source);
-  std::vector<float> up;
+  const auto value_of = [&](int ref) { return ref == InpaintLayer::kInput ? input : outs[ref]; };
+  int in = value_of(l.source);
   if (l.upsample) {
-    up.resize(pixels * ca);
-    resize2x_nearest(in, h >> src_scale, w >> src_scale, ca, up.data(), pool, *k_);
-    in = up.data();
+    const Plan::Value src = plan.value(in);
+    const int up = plan.produce(2 * src.h, 2 * src.w, src.c);
+    plan.consume(in);
+    plan.push([this, in, up, src](Plan& pl, ThreadPool& tp) {
+      resize2x_nearest(pl.data(in), src.h, src.w, src.c, pl.data(up), tp, *k_);
+    });
+    in = up;
   }
-  if (l.skip == InpaintLayer::kNoSkip) {
-    if (l.upsample) scratch.swap(up);
-    return l.upsample ? scratch.data() : in;
-  }
-  const int cb = channels(l.skip);
-  scratch.resize(pixels * (ca + cb));
-  concat_channels(in, ca, data(l.skip), cb, pixels, scratch.data(), pool, *k_);
-  return scratch.data();
-}
-
-// ---- the filler -----------------------------------------------------------------------------
-
-namespace {
-
-int round_up(int v, int m) { return (v + m - 1) / m * m; }
-
-// Grows [lo, lo + len) to a multiple of m inside [0, limit): to the right first, then to
-// the left. Returns the padded length (>= the grown one when limit is too small).
-int fit_span(int& lo, int& len, int limit, int m) {
-  const int want = round_up(len, m);
-  const int right = std::min(want - len, limit - (lo + len));
-  len += right;
-  const int left = std::min(want - len, lo);
-  lo -= left;
-  len += left;
-  return want;
-}
-
-// The window's network input: rgb in [-1, 1] and hole (1 where not known or padding).
-void window_input(const cv::Mat& image, const cv::Mat& known, const cv::Rect& win, int ph, int pw,
-                  std::vector<float>& rgb, std::vector<float>& hole) {
-  rgb.assign(size_t(ph) * pw * 3, 0.0f);
-  hole.assign(size_t(ph) * pw, 1.0f);
-  for (int y = 0; y < win.height; ++y) {
-    const cv::Vec4b* px = image.ptr<cv::Vec4b>(win.y + y) + win.x;
-    const uint8_t* kn = known.ptr<uint8_t>(win.y + y) + win.x;
-    for (int x = 0; x < win.width; ++x) {
-      const size_t p = size_t(y) * pw + x;
-      for (int c = 0; c < 3; ++c) rgb[p * 3 + c] = px[x][2 - c] / 127.5f - 1.0f;  // BGR -> RGB
-      hole[p] = kn[x] ? 0.0f : 1.0f;
-    }
-  }
-}
-
-uint8_t to_byte(float v) { return cv::saturate_cast<uint8_t>(std::lround((v + 1.0f) * 127.5f)); }
-
-void fill_core(const InpaintNet& net, const cv::Mat& image, const cv::Mat& known,
-               const cv::Mat& fill, const cv::Rect& core, int halo, cv::Mat& result,
-               ThreadPool& pool) {
-  cv::Rect win = cv::Rect(core.x - halo, core.y - halo, core.width + 2 * halo, core.height + 2 * halo) &
-                 cv::Rect(0, 0, image.cols, image.rows);
-  const int m = net.multiple();
-  const int pw = fit_span(win.x, win.width, image.cols, m);
-  const int ph = fit_span(win.y, win.height, image.rows, m);
-  std::vector<float> rgb, hole, out(size_t(ph) * pw * 3);
-  window_input(image, known, win, ph, pw, rgb, hole);
-  net.run(rgb.data(), hole.data(), ph, pw, out.data(), pool);
-  for (int y = core.y; y < core.y + core.height; ++y) {
-    const uint8_t* f = fill.ptr<uint8_t>(y);
-    cv::Vec4b* dst = result.ptr<cv::Vec4b>(y);
-    for (int x = core.x; x < core.x + core.width; ++x) {
-      if (!f[x]) continue;
-      const float* o = &out[(size_t(y - win.y) * pw + (x - win.x)) * 3];
-      for (int c = 0; c < 3; ++c) dst[x][2 - c] = to_byte(o[c]);
-    }
-  }
-}
-
-// The network's input colour: its prefill in every unknown pixel.
-cv::Mat prefilled(Prefill prefill, const cv::Mat& image, const cv::Mat& known, ThreadPool& pool) {
-  switch (prefill) {
-    case Prefill::PushPull: return push_pull_fill(image, known, known == 0);
-    case Prefill::Harmonic: return harmonic_fill(image, known, known == 0, {}, pool);
-    case Prefill::None: break;
-  }
-  return image;
-}
-
-}  // namespace
-
-cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat& known,
-                      const cv::Mat& fill, const InpaintTiling& tiling, ThreadPool& pool) {
-  if (image.type() != CV_8UC4 || known.type() != CV_8UC1 || fill.type() != CV_8UC1 ||
-      known.size() != image.size() || fill.size() != image.size())
-    throw std::invalid_argument("inpaint_layer: needs a CV_8UC4 image and CV_8UC1 masks of its size");
-  if (tiling.core < net.multiple() || tiling.halo < 0)
-    throw std::invalid_argument("inpaint_layer: tile core must be at least the net's multiple, halo >= 0");
-  cv::Mat result = image.clone();
-  std::vector<cv::Point> points;
-  cv::findNonZero(fill, points);
-  if (points.empty()) return result;
-  const cv::Mat source = prefilled(net.prefill(), image, known, pool);
-  const cv::Rect box = cv::boundingRect(points);
-  for (int y = box.y; y < box.br().y; y += tiling.core)
-    for (int x = box.x; x < box.br().x; x += tiling.core) {
-      const cv::Rect cell = cv::Rect(x, y, tiling.core, tiling.core) & box;
-      std::vector<cv::Point> in_cell;
-      cv::findNonZero(fill(cell), in_cell);
-      if (in_cell.empty()) continue;
-      // run on the fill's own box within the cell: sparse cells cost a small window
-      const cv::Rect core = cv::boundingRect(in_cell) + cell.tl();
-      fill_core(net, source, known, fill, core, tiling.halo, result, pool);
-    }
-  return result;
-}
-
-LayerFiller inpaint_net_filler(std::shared_ptr<const InpaintNet> net, InpaintTiling tiling) {
-  if (!net) throw std::invalid_argument("inpaint_net_filler: no network");
-  return [net, tiling](const cv::Mat& image, const cv::Mat& known, const cv::Mat& fill) {
-    return inpaint_layer(*net, image, known, fill, tiling);
-  };
+  if (l.skip == InpaintLayer::kNoSkip) return in;
+  const int skip = value_of(l.skip);
+  const Plan::Value a = plan.value(in), b = plan.value(skip);
+  const int cat = plan.produce(a.h, a.w, a.c + b.c);
+  plan.consume(in);
+  plan.consume(skip);
+  plan.push([this, in, skip, cat, a, b](Plan& pl, ThreadPool& tp) {
+    concat_channels(pl.data(in), a.c, pl.data(skip), b.c, int64_t(a.h) * a.w, pl.data(cat), tp, *k_);
+  });
+  return cat;
 }
 
 }  // namespace ampi

@@ -1,5 +1,5 @@
-// The inpainting generator (training/inpaint_model.py) on ampi's kernels, and the
-// LayerFiller that runs it over an MPI layer's margin in bounded memory.
+// The inpainting generator (training/inpaint_model.py) on ampi's kernels. The filler
+// that runs it over an MPI layer's margin in bounded memory is inpaint/net_filler.h.
 //
 // The graph is read from the weight file (training/export_inpaint.py writes it): a list
 // of convolutions, each reading an earlier layer's output (or the network input),
@@ -13,17 +13,18 @@
 //      the network trained on): "push-pull" (inpaint/push_pull.h) or "harmonic"
 //      (inpaint/harmonic_fill.h); input [rgb, hole], output rgb + hole * tanh(last): a
 //      learned correction of that fill inside the hole. inpaint_layer does the pre-fill.
+//
+// run() unrolls the graph for the window's size on the shared executor (nets/plan.h), so
+// outputs no later layer reads share memory.
 #pragma once
 #include <memory>
 #include <string>
 #include <vector>
 
-#include <opencv2/core.hpp>
-
 #include "engine/thread_pool.h"
-#include "inpaint/mpi_inpaint.h"
 #include "kernels/conv.h"
 #include "kernels/kernel_table.h"
+#include "nets/plan.h"
 #include "weights_format/weight_file.h"
 
 namespace ampi {
@@ -49,15 +50,15 @@ class InpaintNet {
   static constexpr int kInChannels = 4;  // rgb with the hole zeroed, hole
   static constexpr int kOutChannels = 3;
 
-  // Reads and checks the graph and every tensor's shape; throws std::runtime_error
-  // "PATH: problem".
-  static InpaintNet load(const std::string& path, const KernelTable& k = kernels());
+  // Checks the architecture (arch::kInpaintGatedConv), the graph and every tensor's
+  // shape; throws std::runtime_error "PATH: problem". Programs load it through
+  // load_inpaint_net (nets/model_loader.h).
   static InpaintNet from_file(const WeightFile& file, const KernelTable& k = kernels());
 
   // rgb [h][w][3] in [-1, 1] (the prefill in the hole unless prefill() is None), hole
   // [h][w] (1 = unknown, 0 = known); h and w multiples of multiple(). out [h][w][3]: the
-  // prediction at every pixel (the caller keeps its known pixels). Scratch memory: a few
-  // dozen floats per pixel, freed on return.
+  // prediction at every pixel (the caller keeps its known pixels). Scratch memory: one
+  // arena of a few dozen floats per pixel, freed on return.
   void run(const float* rgb, const float* hole, int h, int w, float* out,
            ThreadPool& pool = default_pool()) const;
 
@@ -70,39 +71,17 @@ class InpaintNet {
 
  private:
   InpaintNet() = default;
-  const float* layer_input(int i, const std::vector<std::vector<float>>& outs,
-                           const std::vector<float>& x, int h, int w, std::vector<float>& scratch,
-                           ThreadPool& pool) const;
+  // Adds the steps that make layer i's convolution input to `plan`: its source,
+  // up-sampled when asked, then its skip beside it. `outs` holds the earlier layers'
+  // values, `input` the network input's. Returns the value the convolution reads.
+  int add_layer_input(Plan& plan, int i, const std::vector<int>& outs, int input) const;
 
   std::vector<InpaintLayer> layers_;
   std::vector<Conv2d> convs_;
-  std::vector<int> last_use_;  // index of the last layer reading each layer's output
   ActivationSpec feature_act_;
   int multiple_ = 4;
   Prefill prefill_ = Prefill::None;  // None: version 1, the hole zeroed
   const KernelTable* k_ = nullptr;
 };
-
-// How the filler cuts a layer into network runs: square cores of `core` pixels over the
-// bounding box of the pixels to fill, each run on the core plus `halo` pixels of context
-// on every side (clipped to the image), so memory stays bounded by one window whatever
-// the photo's size. Cores without a pixel to fill are skipped. The defaults keep the
-// halo's extra work near a third of a core (448^2 / 384^2) and one window's activations
-// near 30 MB; 32 px of context is a quarter of the 128 px crops the network trained on.
-struct InpaintTiling {
-  int core = 384;
-  int halo = 32;
-};
-
-// Fills `fill` pixels of a BGRA layer with the network's prediction from the `known`
-// pixels (everything not known is the network's hole); every other pixel is unchanged.
-// For a version-2 network, its prefill first fills every unknown pixel of the whole image
-// (one pass, like push_pull_filler), then the windows read from that.
-cv::Mat inpaint_layer(const InpaintNet& net, const cv::Mat& image, const cv::Mat& known,
-                      const cv::Mat& fill, const InpaintTiling& tiling = {},
-                      ThreadPool& pool = default_pool());
-
-// inpaint_layer as a LayerFiller (inpaint/mpi_inpaint.h); shares the network.
-LayerFiller inpaint_net_filler(std::shared_ptr<const InpaintNet> net, InpaintTiling tiling = {});
 
 }  // namespace ampi

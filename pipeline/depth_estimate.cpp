@@ -5,7 +5,7 @@
 
 namespace ampi {
 
-cv::Mat estimate_disparity(DepthNet& net, const cv::Mat& bgr, int max_side, ThreadPool& pool) {
+cv::Mat estimate_disparity(DepthModel& net, const cv::Mat& bgr, int max_side, ThreadPool& pool) {
   if (bgr.type() != CV_8UC3 || bgr.empty())
     throw std::invalid_argument("estimate_disparity: expects a non-empty 8-bit BGR image");
   const ImageSize work = depth_working_size(bgr.rows, bgr.cols, max_side);

@@ -5,8 +5,9 @@
 #include <stdexcept>
 
 #include "engine/memory_budget.h"
-#include "inpaint/inpaint_net.h"
-#include "nets/weights_path.h"
+#include "inpaint/net_filler.h"
+#include "nets/bundled_weights.h"
+#include "nets/model_loader.h"
 #include "pipeline/depth_estimate.h"
 #include "pipeline/depth_io.h"
 #include "pipeline/photo_io.h"
@@ -20,8 +21,7 @@ LayerFiller make_layer_filler(Inpainter kind, const std::string& weights) {
     case Inpainter::PushPull: return push_pull_filler();
     case Inpainter::Network: break;
   }
-  const std::string path = weights.empty() ? find_weights("inpaint.ampw") : weights;
-  return inpaint_net_filler(std::make_shared<const InpaintNet>(InpaintNet::load(path)));
+  return inpaint_net_filler(std::make_shared<const InpaintNet>(load_inpaint_net(inpaint_weights_path(weights))));
 }
 
 MpiMaker::MpiMaker(MpiOptions options) : options_(std::move(options)) {
@@ -46,10 +46,8 @@ cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, cv::Size photo_size, con
     return disparity;
   }
   if (!depth_net_) {
-    const std::string path = options_.depth_weights.empty()
-                                 ? find_weights("depth_" + options_.depth_model + ".ampw")
-                                 : options_.depth_weights;
-    depth_net_.emplace(progress.stage("load depth", [&] { return DepthNet::load(path); }));
+    const std::string path = depth_weights_path(options_.depth_weights, options_.depth_model);
+    depth_net_ = progress.stage("load depth", [&] { return load_depth_model(path); });
   }
   return progress.stage("depth", [&] {
     const int side = options_.working_size ? options_.working_size : depth_net_->working_long_side();

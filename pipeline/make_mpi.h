@@ -8,7 +8,7 @@
 
 #include "inpaint/mpi_inpaint.h"
 #include "mpi/mpi.h"
-#include "nets/depth_net.h"
+#include "nets/depth_model.h"
 #include "pipeline/progress.h"
 #include "slicing/adaptive.h"
 #include "slicing/depth_edges.h"
@@ -87,7 +87,7 @@ class MpiMaker {
   LayerFiller& filler();
 
   MpiOptions options_;
-  std::optional<DepthNet> depth_net_;
+  std::unique_ptr<DepthModel> depth_net_;
   std::optional<LayerFiller> filler_;
   std::string inpainter_;
 };

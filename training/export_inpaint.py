@@ -2,7 +2,7 @@
 parity fixtures the C++ tests compare against.
 
 File contents (read by inpaint/inpaint_net.cpp):
-  metadata  model = "ampi-inpaint", inpaint.version (1: hole zeroed, output the fill;
+  metadata  arch = "ampi.inpaint.gated-conv", inpaint.version (1: hole zeroed, output the fill;
             2: hole pre-filled by the fill named in inpaint.prefill, output a residual
             on it inside the hole; training/inpaint_model.py), the graph of
             training/inpaint_model.py as parallel int arrays (inpaint.source, .upsample,
@@ -45,6 +45,7 @@ import inpaint_push_pull  # noqa: E402
 from weights_format.ampw import write_ampw  # noqa: E402
 
 FIXTURES = os.path.join(ROOT, "tests", "fixtures", "inpaint")
+ARCH_NAME = "ampi.inpaint.gated-conv"  # nets/architectures.h
 CASE_HEIGHT, CASE_WIDTH = 28, 36  # multiples of 4, not square, small enough for qemu
 
 
@@ -61,7 +62,7 @@ def graph_metadata(layers, version: int = 2, prefill: str = im.PREFILL):
         raise ValueError("layer names may not contain commas")
     cols = list(zip(*layers))
     return {
-        "model": "ampi-inpaint",
+        "arch": ARCH_NAME,
         "inpaint.version": version,
         **({"inpaint.prefill": prefill} if version == 2 else {}),
         "inpaint.layer_names": ",".join(names),
@@ -98,8 +99,8 @@ def import_ampw(path: str) -> im.InpaintGenerator:
     fresh checkout start from the bundled weights, which have no checkpoint beside them."""
     from weights_format.ampw import read_ampw
     meta, tensors = read_ampw(path)
-    if meta.get("model") != "ampi-inpaint":
-        raise ValueError(f"{path}: model {meta.get('model')!r} is not ampi-inpaint")
+    if meta.get("arch") != ARCH_NAME:
+        raise ValueError(f"{path}: architecture {meta.get('arch')!r} is not {ARCH_NAME}")
     g = im.InpaintGenerator(residual=int(meta["inpaint.version"]) == 2)
     if meta["inpaint.layer_names"] != ",".join(row[0] for row in g.layers_spec):
         raise ValueError(f"{path}: its graph is not training/inpaint_model.py's LAYERS")

@@ -10,9 +10,10 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "inpaint/inpaint_net.h"
+#include "inpaint/net_filler.h"
 #include "inpaint/harmonic_fill.h"
 #include "inpaint/push_pull.h"
+#include "nets/model_loader.h"
 #include "support/random.h"
 
 using namespace ampi;
@@ -48,7 +49,7 @@ void check_parity(const std::string& weights, const std::string& case_path) {
   REQUIRE(range > 0.1f);  // a degenerate fixture would compare nothing
   for (Isa isa : runnable_isas()) {
     INFO("isa " << isa_name(isa) << ", weights " << weights << ", case " << case_path);
-    const InpaintNet net = InpaintNet::load(weights, kernels_for(isa));
+    const InpaintNet net = load_inpaint_net(weights, kernels_for(isa));
     std::vector<float> out(n);
     net.run(c.rgb.f32(), c.hole.f32(), c.h, c.w, out.data());
     const float diff = test::max_abs_diff(out.data(), e, n);
@@ -89,7 +90,7 @@ cv::Mat changed_pixels(const cv::Mat& a, const cv::Mat& b, bool alpha) {
 
 std::string expect_load_error(const std::string& file) {
   try {
-    InpaintNet::load(kFixtures + file);
+    load_inpaint_net(kFixtures + file);
   } catch (const std::runtime_error& e) {
     return e.what();
   }
@@ -108,7 +109,7 @@ TEST_CASE("inpaint net: bundled weights match PyTorch on every ISA", "[inpaint]"
 }
 
 TEST_CASE("inpaint net: the graph is read from the file", "[inpaint]") {
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const InpaintNet net = load_inpaint_net(kFixtures + "tiny.ampw");
   REQUIRE(net.layers().size() == 12);
   CHECK(net.multiple() == 4);
   CHECK(net.layers().front().stride == 2);
@@ -123,7 +124,7 @@ TEST_CASE("inpaint net: the graph is read from the file", "[inpaint]") {
 
 TEST_CASE("inpaint net: version 2 changes only the hole of its input", "[inpaint]") {
   const Case c = load_case(kFixtures + "tiny_case.ampw");
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const InpaintNet net = load_inpaint_net(kFixtures + "tiny.ampw");
   const size_t pixels = size_t(c.h) * c.w;
   std::vector<float> out(pixels * 3);
   net.run(c.rgb.f32(), c.hole.f32(), c.h, c.w, out.data());
@@ -144,7 +145,7 @@ TEST_CASE("inpaint net: version 2 changes only the hole of its input", "[inpaint
 
 TEST_CASE("inpaint net: results do not depend on the thread count", "[inpaint]") {
   const Case c = load_case(kFixtures + "tiny_case.ampw");
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const InpaintNet net = load_inpaint_net(kFixtures + "tiny.ampw");
   const size_t n = size_t(c.h) * c.w * 3;
   std::vector<float> one(n), two(n);
   ThreadPool single(1), pair(2);
@@ -154,7 +155,7 @@ TEST_CASE("inpaint net: results do not depend on the thread count", "[inpaint]")
 }
 
 TEST_CASE("inpaint net: bad inputs and bad files are one-line errors", "[inpaint]") {
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const InpaintNet net = load_inpaint_net(kFixtures + "tiny.ampw");
   std::vector<float> rgb(30 * 30 * 3), hole(30 * 30), out(30 * 30 * 3);
   CHECK_THROWS_AS(net.run(rgb.data(), hole.data(), 30, 30, out.data()), std::invalid_argument);
 
@@ -168,12 +169,15 @@ TEST_CASE("inpaint net: bad inputs and bad files are one-line errors", "[inpaint
   CHECK(missing.find('\n') == std::string::npos);
   const std::string prefill = expect_load_error("bad_prefill.ampw");
   CHECK(prefill == kFixtures + "bad_prefill.ampw: inpaint.prefill 'telea' is not 'push-pull' or 'harmonic'");
-  const std::string depth = expect_load_error("tiny_case.ampw");
-  CHECK(depth.find("not an inpainting network") != std::string::npos);
+  const std::string data = expect_load_error("tiny_case.ampw");  // a test case, no network
+  CHECK(data == kFixtures + "tiny_case.ampw: no 'arch' metadata: not a network weight file");
+  const std::string depth = expect_load_error("../../../weights/depth_lite.ampw");
+  CHECK(depth.find("depth_lite.ampw: architecture 'ampi.depth.dwt-mobilenetv3' is a depth network, "
+                   "not an inpainting network") != std::string::npos);
 }
 
 TEST_CASE("inpaint filler: changes only the pixels to fill", "[inpaint]") {
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const InpaintNet net = load_inpaint_net(kFixtures + "tiny.ampw");
   for (uint32_t seed : {1u, 2u}) {
     INFO("seed " << seed);
     const Layer l = random_layer(70, 90, seed);
@@ -190,7 +194,7 @@ TEST_CASE("inpaint filler: one window over the whole layer equals a direct run",
   for (const auto& [file, prefill] : {std::pair<const char*, Prefill>{"tiny.ampw", Prefill::Harmonic},
                                       std::pair<const char*, Prefill>{"tiny_push_pull.ampw", Prefill::PushPull}}) {
     INFO(file);
-    const InpaintNet net = InpaintNet::load(kFixtures + file);
+    const InpaintNet net = load_inpaint_net(kFixtures + file);
     REQUIRE(net.prefill() == prefill);
     const int h = 48, w = 64;  // multiples of 4: the window needs no padding
     const Layer l = random_layer(h, w, 3);
@@ -224,7 +228,7 @@ TEST_CASE("inpaint filler: one window over the whole layer equals a direct run",
 }
 
 TEST_CASE("inpaint filler: tiles cover a fill region larger than one core", "[inpaint]") {
-  const InpaintNet net = InpaintNet::load(kFixtures + "tiny.ampw");
+  const InpaintNet net = load_inpaint_net(kFixtures + "tiny.ampw");
   const Layer l = random_layer(101, 133, 4);  // odd sizes: windows are padded
   const cv::Mat tiled = inpaint_layer(net, l.image, l.known, l.fill, {12, 4});
   const cv::Mat changed = changed_pixels(tiled, l.image, false);

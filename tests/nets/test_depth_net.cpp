@@ -9,7 +9,9 @@
 #include <string>
 #include <vector>
 
+#include "nets/architectures.h"
 #include "nets/depth_net.h"
+#include "nets/model_loader.h"
 #include "support/random.h"
 #include "weights_format/npy.h"
 
@@ -35,8 +37,10 @@ TEST_CASE("depth net matches PyTorch within 1e-4 of the output range, every ISA 
   ThreadPool pool(2);
   for (const char* variant : {"lite", "heavy"}) {
     for (Isa isa : runnable_isas()) {
-      DepthNet net = DepthNet::load(weights(variant), kernels_for(isa));
+      const std::unique_ptr<DepthModel> model = load_depth_model(weights(variant), kernels_for(isa));
+      DepthModel& net = *model;
       CHECK(net.variant() == variant);
+      CHECK(net.architecture() == arch::kDepthDwtMobileNetV3);
       for (const char* size : {"64x96", "50x70"}) {
         INFO("variant " << variant << ", isa " << isa_name(isa) << ", input " << size);
         const Tensor input = fixture(std::string("depth_input_") + size);
@@ -56,7 +60,8 @@ TEST_CASE("depth net matches PyTorch within 1e-4 of the output range, every ISA 
 }
 
 TEST_CASE("depth net: results do not depend on the thread count or on earlier runs") {
-  DepthNet net = DepthNet::load(weights("lite"));
+  const std::unique_ptr<DepthModel> model = load_depth_model(weights("lite"));
+  DepthModel& net = *model;
   const uint32_t seed = 11;
   INFO("seed " << seed);
   const std::vector<float> rgb = test::random_floats(40 * 72 * 3, seed, 0.0f, 1.0f);
@@ -70,8 +75,8 @@ TEST_CASE("depth net: results do not depend on the thread count or on earlier ru
 }
 
 TEST_CASE("depth net metadata: parameter counts and multiple") {
-  const DepthNet lite = DepthNet::load(weights("lite"));
-  const DepthNet heavy = DepthNet::load(weights("heavy"));
+  const DepthNet lite = DepthNet::from_file(WeightFile::open(weights("lite")));
+  const DepthNet heavy = DepthNet::from_file(WeightFile::open(weights("heavy")));
   CHECK(lite.multiple() == 32);
   CHECK(heavy.multiple() == 32);
   // A file may ask for a working resolution (weights trained on small images do).
@@ -97,11 +102,11 @@ TEST_CASE("depth working size: long side capped, aspect kept, never upscaled") {
 TEST_CASE("depth net rejects files that are not depth networks, naming the file") {
   const std::string other = source_path("tests/fixtures/weights/small.ampw");
   try {
-    DepthNet::load(other);
+    load_depth_model(other);
     FAIL("loading " << other << " should have thrown");
   } catch (const std::runtime_error& e) {
     INFO(e.what());
     CHECK(std::string(e.what()).find(other) == 0);
   }
-  CHECK_THROWS_AS(DepthNet::load(source_path("tests/fixtures/nets/missing.ampw")), std::runtime_error);
+  CHECK_THROWS_AS(load_depth_model(source_path("tests/fixtures/nets/missing.ampw")), std::runtime_error);
 }
