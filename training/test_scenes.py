@@ -13,9 +13,11 @@ import numpy as np
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import photo_folder  # noqa: E402
 import scenes  # noqa: E402
-from scenes import (Atmosphere, Box, Camera, Light, Material, Quad, Scene, SceneObject,  # noqa: E402
-                    Sphere, ground_plane)
+import textures  # noqa: E402
+from scenes import Atmosphere, Box, Camera, Light, Quad, Scene, SceneObject, Sphere, ground_plane  # noqa: E402
+from textures import Material  # noqa: E402
 
 SMALL = (96, 72)
 SEEDS = (0, 1, 2, 3, 4, 5, 6, 7, 10 ** 9, 10 ** 9 + 1)
@@ -129,7 +131,7 @@ class Texturing(unittest.TestCase):
         crop = (2.0, 3.0, 9.0, 7.0)
         x = rng.uniform(-30, 30, 60).astype(np.float32)
         y = rng.uniform(-30, 30, 60).astype(np.float32)
-        got = scenes.sample_bilinear(torch.from_numpy(image), crop, x, y)
+        got = textures.sample_bilinear(torch.from_numpy(image), crop, x, y)
         for i in range(x.size):
             px = mirrored(float(x[i]), crop[2] - 1) + crop[0]
             py = mirrored(float(y[i]), crop[3] - 1) + crop[1]
@@ -145,7 +147,7 @@ class Texturing(unittest.TestCase):
     def test_mip_levels_average_two_by_two_blocks(self):
         seed = 3
         image = np.random.default_rng(seed).integers(0, 256, (40, 36, 3), dtype=np.uint8)
-        levels = scenes.mip_pyramid(image)
+        levels = textures.mip_pyramid(image)
         self.assertEqual([tuple(level.shape) for level in levels], [(3, 40, 36), (3, 20, 18), (3, 10, 9)])
         blocks = image.astype(np.float64).reshape(20, 2, 18, 2, 3).mean(axis=(1, 3))
         np.testing.assert_allclose(levels[1].numpy().transpose(1, 2, 0), blocks, atol=0.5,
@@ -198,32 +200,32 @@ class RandomScenes(unittest.TestCase):
 
 class ValidationSplit(unittest.TestCase):
     def test_seed_split(self):
-        self.assertFalse(scenes.is_validation_seed(0))
-        self.assertFalse(scenes.is_validation_seed(10 ** 9 - 1))
-        self.assertTrue(scenes.is_validation_seed(10 ** 9))
+        self.assertFalse(photo_folder.is_validation_seed(0))
+        self.assertFalse(photo_folder.is_validation_seed(10 ** 9 - 1))
+        self.assertTrue(photo_folder.is_validation_seed(10 ** 9))
 
     def test_every_tenth_photo_of_each_folder_is_validation(self):
-        photos = scenes.list_photos()
-        train, val = scenes.list_photos('train'), scenes.list_photos('val')
+        photos = photo_folder.list_photos()
+        train, val = photo_folder.list_photos('train'), photo_folder.list_photos('val')
         self.assertFalse(set(train) & set(val))
         self.assertEqual(sorted(train + val), photos)
         folders = {p.parent for p in photos}
         expected = sum(len([p for p in photos if p.parent == f]) // 10 for f in folders)
         self.assertEqual(len(val), expected)
         first_folder = sorted(p for p in photos if p.parent == sorted(folders)[0])
-        self.assertEqual(scenes.photo_split(first_folder[9]), 'val')
-        self.assertEqual(scenes.photo_split(first_folder[8]), 'train')
+        self.assertEqual(photo_folder.photo_split(first_folder[9]), 'val')
+        self.assertEqual(photo_folder.photo_split(first_folder[8]), 'train')
 
     def test_every_fifth_photo_is_ordinal_validation_and_no_training_texture(self):
-        photos = scenes.list_photos()
-        ordinal_val = {p for p in photos if scenes.ordinal_split(p) == 'val'}
-        self.assertLessEqual(set(scenes.list_photos('val')), ordinal_val)  # the synthetic ones too
+        photos = photo_folder.list_photos()
+        ordinal_val = {p for p in photos if photo_folder.ordinal_split(p) == 'val'}
+        self.assertLessEqual(set(photo_folder.list_photos('val')), ordinal_val)  # the synthetic ones too
         folders = {p.parent for p in photos}
         self.assertEqual(len(ordinal_val), sum(len([p for p in photos if p.parent == f]) // 5 for f in folders))
-        self.assertFalse(set(scenes.texture_pool('train').paths) & ordinal_val)
+        self.assertFalse(set(textures.texture_pool('train').paths) & ordinal_val)
 
     def test_texture_pools_are_disjoint_and_used_by_their_seeds(self):
-        train, val = scenes.texture_pool('train'), scenes.texture_pool('val')
+        train, val = textures.texture_pool('train'), textures.texture_pool('val')
         self.assertFalse(set(train.paths) & set(val.paths))
         for seed, pool in ((5, train), (10 ** 9 + 5, val)):
             with self.subTest(seed=seed):
@@ -235,13 +237,13 @@ class ValidationSplit(unittest.TestCase):
 
     def test_bad_paths_are_named_in_the_error(self):
         with self.assertRaisesRegex(ValueError, 'notes.txt'):
-            scenes.photo_split(scenes.photo_root() / 'kodak24' / 'notes.txt')
+            photo_folder.photo_split(photo_folder.photo_root() / 'kodak24' / 'notes.txt')
         with tempfile.TemporaryDirectory() as empty:
             missing = os.path.join(empty, 'nowhere')
             with self.assertRaisesRegex(RuntimeError, 'nowhere'):
-                scenes.list_photos(root=missing)
+                photo_folder.list_photos(root=missing)
             with self.assertRaisesRegex(RuntimeError, 'no train photos'):
-                scenes.list_photos('train', root=empty)
+                photo_folder.list_photos('train', root=empty)
 
 
 class Dataset(unittest.TestCase):

@@ -314,9 +314,9 @@ def train(args):
     source = make_source(args.data, size)
     ordinal_train = ordinal_val = None
     if args.ordinal:
-        import scenes  # the photo folder
-        ordinal_train = ordinal_data.load_split("train", scenes.photo_root(), args.ordinal)
-        ordinal_val = ordinal_data.load_split("val", scenes.photo_root(), args.ordinal)
+        import photo_folder  # the photo folder
+        ordinal_train = ordinal_data.load_split("train", photo_folder.photo_root(), args.ordinal)
+        ordinal_val = ordinal_data.load_split("val", photo_folder.photo_root(), args.ordinal)
     best_of = "ordinal_whdr" if ordinal_val else "val_loss"  # what best.pt keeps the lowest of
     ckpt_path = run / "checkpoint.pt"
     model = initial_model(args, source, size, resuming=ckpt_path.exists())
