@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tests of the procedural RGB-D scene generator (training/scenes.py).
+"""Tests of the procedural RGB-D scene generator (training/scenes.py and the modules it uses).
 
 Run: /usr/bin/python3 training/test_scenes.py (ctest runs it as training_scenes)."""
 
@@ -14,9 +14,12 @@ import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import photo_folder  # noqa: E402
+import raytracer  # noqa: E402
+import scene_sampler  # noqa: E402
 import scenes  # noqa: E402
 import textures  # noqa: E402
-from scenes import Atmosphere, Box, Camera, Light, Quad, Scene, SceneObject, Sphere, ground_plane  # noqa: E402
+from raytracer import Atmosphere, Camera, Light, Scene, SceneObject  # noqa: E402
+from shapes import Box, Quad, Sphere, ground_plane  # noqa: E402
 from textures import Material  # noqa: E402
 
 SMALL = (96, 72)
@@ -61,7 +64,7 @@ def wall_and_box_scene(box_first=False):
 class HandBuiltScenes(unittest.TestCase):
     def test_box_occludes_wall_with_exact_disparity(self):
         scene = wall_and_box_scene()
-        radiance, disparity = scenes.render(scene)
+        radiance, disparity = raytracer.render(scene)
         box_pixel = pixel_of(scene.camera, (0, 1.5, 3.5))
         wall_pixel = pixel_of(scene.camera, (-3, 2.5, 10))
         self.assertAlmostEqual(float(disparity[box_pixel]), 1 / 3.5, places=5)
@@ -74,7 +77,7 @@ class HandBuiltScenes(unittest.TestCase):
 
     def test_nearer_box_hides_part_of_the_sphere_behind_it(self):
         scene = wall_and_box_scene()
-        _, disparity = scenes.render(scene)
+        _, disparity = raytracer.render(scene)
         hidden = pixel_of(scene.camera, (0.4, 1.5, 3.5))      # on the box, in front of the sphere
         visible = pixel_of(scene.camera, (1.1, 1.5, 6.0))     # the sphere's right side, beside the box
         self.assertAlmostEqual(float(disparity[hidden]), 1 / 3.5, places=5)
@@ -82,14 +85,14 @@ class HandBuiltScenes(unittest.TestCase):
         self.assertLess(disparity[visible], 1 / 5.0)
 
     def test_drawing_order_does_not_matter(self):
-        _, first = scenes.render(wall_and_box_scene(box_first=False))
-        _, second = scenes.render(wall_and_box_scene(box_first=True))
+        _, first = raytracer.render(wall_and_box_scene(box_first=False))
+        _, second = raytracer.render(wall_and_box_scene(box_first=True))
         np.testing.assert_array_equal(first, second)
 
     def test_ground_disparity_is_exact_and_grows_downwards(self):
         camera = level_camera(eye_height=2.0)
         scene = plain_scene(camera, [SceneObject(ground_plane(), Material(GREY), False)])
-        _, disparity = scenes.render(scene)
+        _, disparity = raytracer.render(scene)
         rows = np.arange(camera.height)
         below = rows + 0.5 > camera.height / 2
         expected = (rows[below] + 0.5 - camera.height / 2) / camera.focal / 2.0   # y_n / eye height
@@ -101,7 +104,7 @@ class HandBuiltScenes(unittest.TestCase):
         camera = level_camera()
         ground = SceneObject(ground_plane(), Material(GREY), False)
         box = SceneObject(Box((0, 0.6, 4), (0.3, 0.3, 0.3)), Material(RED))
-        radiance, _ = scenes.render(plain_scene(camera, [ground, box], sun_direction=(0, 1, 0)))
+        radiance, _ = raytracer.render(plain_scene(camera, [ground, box], sun_direction=(0, 1, 0)))
         shaded = radiance[:, pixel_of(camera, (0, 0, 4.2))[0], pixel_of(camera, (0, 0, 4.2))[1]]
         sunlit = radiance[:, pixel_of(camera, (1.5, 0, 4.2))[0], pixel_of(camera, (1.5, 0, 4.2))[1]]
         self.assertLess(shaded.sum() * 2, sunlit.sum())
@@ -112,7 +115,7 @@ class HandBuiltScenes(unittest.TestCase):
         mask = np.zeros((4, 4), dtype=bool)
         mask[:, :2] = True                                     # only the left half is solid
         cutout = SceneObject(Quad((0, 1.5, 5), (1, 0, 0), (0, 1, 0), 1.0, 1.0, mask), Material(RED))
-        _, disparity = scenes.render(plain_scene(camera, [wall, cutout]))
+        _, disparity = raytracer.render(plain_scene(camera, [wall, cutout]))
         self.assertAlmostEqual(float(disparity[pixel_of(camera, (-0.5, 1.5, 5))]), 0.2, places=5)
         self.assertAlmostEqual(float(disparity[pixel_of(camera, (0.5, 1.5, 5))]), 0.1, places=6)
 
@@ -175,20 +178,20 @@ class RandomScenes(unittest.TestCase):
     def test_disparity_positive_where_not_sky_and_zero_in_sky(self):
         for seed in SEEDS:
             with self.subTest(seed=seed):
-                scene = scenes.sample_scene(seed, *SMALL)
-                gbuffer = scenes.raycast(scene)
+                scene = scene_sampler.sample_scene(seed, *SMALL)
+                gbuffer = raytracer.raycast(scene)
                 _, disparity = scenes.render_scene(seed, *SMALL)
                 surface = gbuffer.ids >= 0
                 self.assertTrue(np.all(np.isfinite(disparity)))
                 self.assertTrue(np.all(disparity[surface] > 0))
                 self.assertTrue(np.all(disparity[~surface] == 0))
-                self.assertLess(float(disparity.max()), 1 / scenes.NEAR_CLIP + 1e-3)
-                np.testing.assert_array_equal(disparity, scenes.disparity_of(gbuffer))
+                self.assertLess(float(disparity.max()), 1 / raytracer.NEAR_CLIP + 1e-3)
+                np.testing.assert_array_equal(disparity, raytracer.disparity_of(gbuffer))
 
     def test_scenes_are_varied(self):
-        counts = [len(scenes.sample_scene(seed, *SMALL).objects) for seed in range(8)]
+        counts = [len(scene_sampler.sample_scene(seed, *SMALL).objects) for seed in range(8)]
         self.assertGreater(min(counts), 4, f'objects per scene: {counts}')
-        shapes = {type(o.shape).__name__ for seed in range(8) for o in scenes.sample_scene(seed, *SMALL).objects}
+        shapes = {type(o.shape).__name__ for seed in range(8) for o in scene_sampler.sample_scene(seed, *SMALL).objects}
         self.assertEqual(shapes, {'Box', 'Sphere', 'Cylinder', 'Quad'})
 
     def test_images_are_not_flat(self):
@@ -230,7 +233,7 @@ class ValidationSplit(unittest.TestCase):
         for seed, pool in ((5, train), (10 ** 9 + 5, val)):
             with self.subTest(seed=seed):
                 owned = {id(p) for p in pool.pyramids}
-                used = {id(o.material.pyramid) for o in scenes.sample_scene(seed, *SMALL).objects
+                used = {id(o.material.pyramid) for o in scene_sampler.sample_scene(seed, *SMALL).objects
                         if o.material.pyramid is not None}
                 self.assertTrue(used)
                 self.assertLessEqual(used, owned)
