@@ -65,7 +65,8 @@ def to_tensors(rgb, disparity):
 
 
 class SceneSource:
-    """Procedural scenes by seed (issue 5's generator, training/scenes.py)."""
+    """Procedural scenes by seed (training/scenes.py): exact disparity, and validation seeds
+    textured only with validation photos."""
 
     def __init__(self, size):
         import scenes  # the generator lives beside this file
