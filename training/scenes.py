@@ -37,7 +37,6 @@ from textures import pool_for_seed, texture_pool
 DEFAULT_SIZE = (384, 288)
 
 
-
 def render_scene(seed, width=DEFAULT_SIZE[0], height=DEFAULT_SIZE[1]):
     """(rgb uint8 HxWx3, disparity float32 HxW): one random photo-like scene, exact 1/depth.
 
