@@ -9,7 +9,7 @@
 depth: 50 synthetic validation scenes (training/make_eval_scenes.py: exact disparity,
 textured with validation photos only), `ampi eval depth` with the lite and the heavy
 network. slicing: the validation photos (every tenth photo by sorted name of each folder
-of ../shared/data/photos, training/scenes.py photo_split), `ampi eval slicing` with the
+of ../shared/data/photos, training/photo_folder.py photo_split), `ampi eval slicing` with the
 default (optimal) slicer, with the paper's rule exactly and with its former plane guard;
 the tear penalty's tuning runs on training photos; the default on 50 synthetic scenes
 with their exact depth. ordinal: WHDR of the lite and heavy networks on the real-photo
@@ -111,8 +111,8 @@ def ordinal_rows(out):
 
 
 def ordinal_table(ampi, threads):
-    import scenes
-    root = scenes.photo_root()
+    import photo_folder
+    root = photo_folder.photo_root()
     runs = []
     for split in ('val', 'train'):
         for model in ('lite', 'heavy'):
@@ -204,11 +204,11 @@ def penalty_effect(tuning):
 
 
 def slicing_table(ampi, threads, scene_count, extra):
-    import scenes
-    root = scenes.photo_root()
-    photos = scenes.list_photos('val')
+    import photo_folder
+    root = photo_folder.photo_root()
+    photos = photo_folder.list_photos('val')
     # Where the tear penalty was chosen: training photos only, never the validation ones.
-    tuning_photos = scenes.list_photos('train')[5::10]
+    tuning_photos = photo_folder.list_photos('train')[5::10]
     eval_slicing = [ampi, 'eval', 'slicing', '--threads', str(threads)] + extra
     with tempfile.TemporaryDirectory(prefix='ampi-eval-slicing-') as tmp:
         val_dir, tuning_dir = Path(tmp) / 'val', Path(tmp) / 'tuning'
@@ -244,7 +244,7 @@ def slicing_table(ampi, threads, scene_count, extra):
         '',
         'Made by `/usr/bin/python3 eval/make_tables.py slicing --ampi AMPI`: VAL_PHOTOS holds the',
         f'{len(photos)} validation photos (every tenth photo by sorted name of each folder of',
-        '`../shared/data/photos`, `training/scenes.py` `photo_split`), then:',
+        '`../shared/data/photos`, `training/photo_folder.py` `photo_split`), then:',
         '',
         f'`{command}` ({seconds:.0f} s)',
         '',
@@ -364,9 +364,9 @@ def after_flawed(row):
 
 
 def edges_table(ampi, threads):
-    import scenes
-    root = scenes.photo_root()
-    val = scenes.list_photos('val')
+    import photo_folder
+    root = photo_folder.photo_root()
+    val = photo_folder.list_photos('val')
     # The first validation photo of three folders: textures from photos no network trained on.
     textures = []
     for folder in ('kodak24', 'urban100', 'sun80'):

@@ -8,7 +8,7 @@ packages=(
   libopencv-dev                             # the only C++ library: image/video I/O, filters
   catch2                                    # unit tests (Catch2 v2)
   python3-numpy python3-torch               # fixtures, training, export (Debian's CPU torch)
-  python3-pil                               # JPEG decoding for training/scenes.py textures
+  python3-pil                               # JPEG decoding of the photos (training/photo_folder.py)
   g++-aarch64-linux-gnu qemu-user           # aarch64 cross build, tests run under qemu
   ffmpeg                                    # GIF output (palette) and H.264 through OpenCV
   clang libclang-rt-14-dev                  # libFuzzer targets (fuzz/, scripts/test_reliability.sh)

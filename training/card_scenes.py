@@ -1,7 +1,8 @@
 """A small procedural RGB-D source: photo-textured cards standing on a ground plane.
 
-The built-in data source of train_depth.py (`--data cards`), enough to give the bundled
-weights real structure; issue 5's fuller generator (training/scenes.py) is the richer one.
+The small built-in data source of train_depth.py (`--data cards`), enough to give a
+network real structure; the procedural scenes of training/scenes.py (`--data scenes`, the
+default) are the richer source.
 
 Scene, for a pinhole camera at height 1 looking horizontally (horizon at row `horizon`):
   - the ground plane below the horizon: a pixel r rows under it sees depth f / (r + 0.5),

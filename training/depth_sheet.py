@@ -21,6 +21,7 @@ from PIL import Image
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "weights_format"))
 import export_depth  # noqa: E402
+import photo_folder  # noqa: E402
 import scenes  # noqa: E402
 from ampw import read_ampw  # noqa: E402
 
@@ -77,11 +78,11 @@ def main(argv=None):
     meta, _ = read_ampw(args.weights)
     model = export_depth.import_ampw(args.weights)
     long_side, multiple = int(meta["depth.working_long_side"]), int(meta.get("depth.multiple", 32))
-    photos = scenes.list_photos("val", args.photos)
+    photos = photo_folder.list_photos("val", args.photos)
     chosen = [photos[round(i * (len(photos) - 1) / max(1, args.count - 1))] for i in range(min(args.count, len(photos)))]
     tiles = []
     for path in chosen:
-        rgb = scenes.load_photo(path, max_side=1024)
+        rgb = photo_folder.load_photo(path, max_side=1024)
         tiles.append(tile_pair(rgb, predict(model, rgb, long_side, multiple)))
     Image.fromarray(sheet(tiles, args.columns)).save(args.output, optimize=True)
     print(f"{args.output}: {len(tiles)} validation photos, {Path(args.weights).name} at long side {long_side}")

@@ -29,7 +29,7 @@ from pathlib import Path
 from PIL import Image, ImageOps
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-import scenes  # noqa: E402  (the photo folder)
+import photo_folder  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 PHOTO_LONG_SIDE = 384
@@ -51,9 +51,9 @@ def slim_checkpoint(source: Path, target: Path):
 def pack_photos(out: Path):
     """Every photo at most PHOTO_LONG_SIDE, as JPEG under its own relative name; returns
     {relative name: (scale x, scale y, new width, new height)}."""
-    root = scenes.photo_root()
+    root = photo_folder.photo_root()
     sizes = {}
-    for path in scenes.list_photos():
+    for path in photo_folder.list_photos():
         rel = path.relative_to(root).as_posix()
         with Image.open(path) as image:
             image = ImageOps.exif_transpose(image).convert("RGB")

@@ -52,8 +52,8 @@ MIN_REMOVED, MIN_KNOWN = 0.02, 0.25  # fractions of a crop a sample needs
 
 # transition selection, as slicing/adaptive.h's paper slicer with its plane guard at 0.5
 # (`ampi slice --slicer paper --min-plane-share 0.5`): the slicing the bundled inpainting
-# network trained on. ampi's default slicer now keeps the paper's plane count but places
-# the cuts by dynamic programming (slicing/optimal_cuts.h), with no guard.
+# network trained on. ampi's default slicer differs: it keeps the paper's plane count but
+# places the cuts by dynamic programming (slicing/optimal_cuts.h), with no guard.
 SLICE_EPS, SLICE_XI, SLICE_THRESHOLD, SLICE_MAX_PLANES = 0.001, 8, 0.1, 8
 SLICE_MIN_PLANE_SHARE = 0.5  # each plane > 0.5 / 8 of h
 EDGE_GRADIENT, EDGE_BAND = 6.0, 7  # levels per pixel that make an edge; band width

@@ -18,6 +18,7 @@ import numpy as np
 from PIL import Image
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import photo_folder  # noqa: E402
 import scenes  # noqa: E402
 
 
@@ -26,8 +27,8 @@ def write_scenes(out, count, size):
     images.mkdir(parents=True, exist_ok=True)
     reference.mkdir(parents=True, exist_ok=True)
     for i in range(count):
-        seed = scenes.VALIDATION_SEED_START + i
-        assert scenes.is_validation_seed(seed)
+        seed = photo_folder.VALIDATION_SEED_START + i
+        assert photo_folder.is_validation_seed(seed)
         rgb, disparity = scenes.render_scene(seed, *size)
         name = f'scene_{i:04d}'
         Image.fromarray(rgb).save(images / f'{name}.png')

@@ -92,7 +92,7 @@ class Labelling(unittest.TestCase):
         with tempfile.TemporaryDirectory() as folder:
             path = Path(folder) / "p.png"
             Image.fromarray(coordinate_photo(300, 200)).save(path)
-            with unittest.mock.patch.object(pairs.scenes, "ordinal_split", return_value="train"):
+            with unittest.mock.patch.object(pairs.photo_folder, "ordinal_split", return_value="train"):
                 first, again = pairs.sample_photo(path, "x/p.png"), pairs.sample_photo(path, "x/p.png")
         self.assertEqual(first, again)
         one_round = ["random"] * pairs.RANDOM_PAIRS + ["edge"] * pairs.EDGE_PAIRS

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Tests of the procedural RGB-D scene generator (training/scenes.py).
+"""Tests of the procedural RGB-D scene generator (training/scenes.py and the modules it uses).
 
 Run: /usr/bin/python3 training/test_scenes.py (ctest runs it as training_scenes)."""
 
@@ -13,9 +13,14 @@ import numpy as np
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import photo_folder  # noqa: E402
+import raytracer  # noqa: E402
+import scene_sampler  # noqa: E402
 import scenes  # noqa: E402
-from scenes import (Atmosphere, Box, Camera, Light, Material, Quad, Scene, SceneObject,  # noqa: E402
-                    Sphere, ground_plane)
+import textures  # noqa: E402
+from raytracer import Atmosphere, Camera, Light, Scene, SceneObject  # noqa: E402
+from shapes import Box, Quad, Sphere, ground_plane  # noqa: E402
+from textures import Material  # noqa: E402
 
 SMALL = (96, 72)
 SEEDS = (0, 1, 2, 3, 4, 5, 6, 7, 10 ** 9, 10 ** 9 + 1)
@@ -59,7 +64,7 @@ def wall_and_box_scene(box_first=False):
 class HandBuiltScenes(unittest.TestCase):
     def test_box_occludes_wall_with_exact_disparity(self):
         scene = wall_and_box_scene()
-        radiance, disparity = scenes.render(scene)
+        radiance, disparity = raytracer.render(scene)
         box_pixel = pixel_of(scene.camera, (0, 1.5, 3.5))
         wall_pixel = pixel_of(scene.camera, (-3, 2.5, 10))
         self.assertAlmostEqual(float(disparity[box_pixel]), 1 / 3.5, places=5)
@@ -72,7 +77,7 @@ class HandBuiltScenes(unittest.TestCase):
 
     def test_nearer_box_hides_part_of_the_sphere_behind_it(self):
         scene = wall_and_box_scene()
-        _, disparity = scenes.render(scene)
+        _, disparity = raytracer.render(scene)
         hidden = pixel_of(scene.camera, (0.4, 1.5, 3.5))      # on the box, in front of the sphere
         visible = pixel_of(scene.camera, (1.1, 1.5, 6.0))     # the sphere's right side, beside the box
         self.assertAlmostEqual(float(disparity[hidden]), 1 / 3.5, places=5)
@@ -80,14 +85,14 @@ class HandBuiltScenes(unittest.TestCase):
         self.assertLess(disparity[visible], 1 / 5.0)
 
     def test_drawing_order_does_not_matter(self):
-        _, first = scenes.render(wall_and_box_scene(box_first=False))
-        _, second = scenes.render(wall_and_box_scene(box_first=True))
+        _, first = raytracer.render(wall_and_box_scene(box_first=False))
+        _, second = raytracer.render(wall_and_box_scene(box_first=True))
         np.testing.assert_array_equal(first, second)
 
     def test_ground_disparity_is_exact_and_grows_downwards(self):
         camera = level_camera(eye_height=2.0)
         scene = plain_scene(camera, [SceneObject(ground_plane(), Material(GREY), False)])
-        _, disparity = scenes.render(scene)
+        _, disparity = raytracer.render(scene)
         rows = np.arange(camera.height)
         below = rows + 0.5 > camera.height / 2
         expected = (rows[below] + 0.5 - camera.height / 2) / camera.focal / 2.0   # y_n / eye height
@@ -99,7 +104,7 @@ class HandBuiltScenes(unittest.TestCase):
         camera = level_camera()
         ground = SceneObject(ground_plane(), Material(GREY), False)
         box = SceneObject(Box((0, 0.6, 4), (0.3, 0.3, 0.3)), Material(RED))
-        radiance, _ = scenes.render(plain_scene(camera, [ground, box], sun_direction=(0, 1, 0)))
+        radiance, _ = raytracer.render(plain_scene(camera, [ground, box], sun_direction=(0, 1, 0)))
         shaded = radiance[:, pixel_of(camera, (0, 0, 4.2))[0], pixel_of(camera, (0, 0, 4.2))[1]]
         sunlit = radiance[:, pixel_of(camera, (1.5, 0, 4.2))[0], pixel_of(camera, (1.5, 0, 4.2))[1]]
         self.assertLess(shaded.sum() * 2, sunlit.sum())
@@ -110,7 +115,7 @@ class HandBuiltScenes(unittest.TestCase):
         mask = np.zeros((4, 4), dtype=bool)
         mask[:, :2] = True                                     # only the left half is solid
         cutout = SceneObject(Quad((0, 1.5, 5), (1, 0, 0), (0, 1, 0), 1.0, 1.0, mask), Material(RED))
-        _, disparity = scenes.render(plain_scene(camera, [wall, cutout]))
+        _, disparity = raytracer.render(plain_scene(camera, [wall, cutout]))
         self.assertAlmostEqual(float(disparity[pixel_of(camera, (-0.5, 1.5, 5))]), 0.2, places=5)
         self.assertAlmostEqual(float(disparity[pixel_of(camera, (0.5, 1.5, 5))]), 0.1, places=6)
 
@@ -129,7 +134,7 @@ class Texturing(unittest.TestCase):
         crop = (2.0, 3.0, 9.0, 7.0)
         x = rng.uniform(-30, 30, 60).astype(np.float32)
         y = rng.uniform(-30, 30, 60).astype(np.float32)
-        got = scenes.sample_bilinear(torch.from_numpy(image), crop, x, y)
+        got = textures.sample_bilinear(torch.from_numpy(image), crop, x, y)
         for i in range(x.size):
             px = mirrored(float(x[i]), crop[2] - 1) + crop[0]
             py = mirrored(float(y[i]), crop[3] - 1) + crop[1]
@@ -145,7 +150,7 @@ class Texturing(unittest.TestCase):
     def test_mip_levels_average_two_by_two_blocks(self):
         seed = 3
         image = np.random.default_rng(seed).integers(0, 256, (40, 36, 3), dtype=np.uint8)
-        levels = scenes.mip_pyramid(image)
+        levels = textures.mip_pyramid(image)
         self.assertEqual([tuple(level.shape) for level in levels], [(3, 40, 36), (3, 20, 18), (3, 10, 9)])
         blocks = image.astype(np.float64).reshape(20, 2, 18, 2, 3).mean(axis=(1, 3))
         np.testing.assert_allclose(levels[1].numpy().transpose(1, 2, 0), blocks, atol=0.5,
@@ -173,20 +178,20 @@ class RandomScenes(unittest.TestCase):
     def test_disparity_positive_where_not_sky_and_zero_in_sky(self):
         for seed in SEEDS:
             with self.subTest(seed=seed):
-                scene = scenes.sample_scene(seed, *SMALL)
-                gbuffer = scenes.raycast(scene)
+                scene = scene_sampler.sample_scene(seed, *SMALL)
+                gbuffer = raytracer.raycast(scene)
                 _, disparity = scenes.render_scene(seed, *SMALL)
                 surface = gbuffer.ids >= 0
                 self.assertTrue(np.all(np.isfinite(disparity)))
                 self.assertTrue(np.all(disparity[surface] > 0))
                 self.assertTrue(np.all(disparity[~surface] == 0))
-                self.assertLess(float(disparity.max()), 1 / scenes.NEAR_CLIP + 1e-3)
-                np.testing.assert_array_equal(disparity, scenes.disparity_of(gbuffer))
+                self.assertLess(float(disparity.max()), 1 / raytracer.NEAR_CLIP + 1e-3)
+                np.testing.assert_array_equal(disparity, raytracer.disparity_of(gbuffer))
 
     def test_scenes_are_varied(self):
-        counts = [len(scenes.sample_scene(seed, *SMALL).objects) for seed in range(8)]
+        counts = [len(scene_sampler.sample_scene(seed, *SMALL).objects) for seed in range(8)]
         self.assertGreater(min(counts), 4, f'objects per scene: {counts}')
-        shapes = {type(o.shape).__name__ for seed in range(8) for o in scenes.sample_scene(seed, *SMALL).objects}
+        shapes = {type(o.shape).__name__ for seed in range(8) for o in scene_sampler.sample_scene(seed, *SMALL).objects}
         self.assertEqual(shapes, {'Box', 'Sphere', 'Cylinder', 'Quad'})
 
     def test_images_are_not_flat(self):
@@ -198,50 +203,50 @@ class RandomScenes(unittest.TestCase):
 
 class ValidationSplit(unittest.TestCase):
     def test_seed_split(self):
-        self.assertFalse(scenes.is_validation_seed(0))
-        self.assertFalse(scenes.is_validation_seed(10 ** 9 - 1))
-        self.assertTrue(scenes.is_validation_seed(10 ** 9))
+        self.assertFalse(photo_folder.is_validation_seed(0))
+        self.assertFalse(photo_folder.is_validation_seed(10 ** 9 - 1))
+        self.assertTrue(photo_folder.is_validation_seed(10 ** 9))
 
     def test_every_tenth_photo_of_each_folder_is_validation(self):
-        photos = scenes.list_photos()
-        train, val = scenes.list_photos('train'), scenes.list_photos('val')
+        photos = photo_folder.list_photos()
+        train, val = photo_folder.list_photos('train'), photo_folder.list_photos('val')
         self.assertFalse(set(train) & set(val))
         self.assertEqual(sorted(train + val), photos)
         folders = {p.parent for p in photos}
         expected = sum(len([p for p in photos if p.parent == f]) // 10 for f in folders)
         self.assertEqual(len(val), expected)
         first_folder = sorted(p for p in photos if p.parent == sorted(folders)[0])
-        self.assertEqual(scenes.photo_split(first_folder[9]), 'val')
-        self.assertEqual(scenes.photo_split(first_folder[8]), 'train')
+        self.assertEqual(photo_folder.photo_split(first_folder[9]), 'val')
+        self.assertEqual(photo_folder.photo_split(first_folder[8]), 'train')
 
     def test_every_fifth_photo_is_ordinal_validation_and_no_training_texture(self):
-        photos = scenes.list_photos()
-        ordinal_val = {p for p in photos if scenes.ordinal_split(p) == 'val'}
-        self.assertLessEqual(set(scenes.list_photos('val')), ordinal_val)  # the synthetic ones too
+        photos = photo_folder.list_photos()
+        ordinal_val = {p for p in photos if photo_folder.ordinal_split(p) == 'val'}
+        self.assertLessEqual(set(photo_folder.list_photos('val')), ordinal_val)  # the synthetic ones too
         folders = {p.parent for p in photos}
         self.assertEqual(len(ordinal_val), sum(len([p for p in photos if p.parent == f]) // 5 for f in folders))
-        self.assertFalse(set(scenes.texture_pool('train').paths) & ordinal_val)
+        self.assertFalse(set(textures.texture_pool('train').paths) & ordinal_val)
 
     def test_texture_pools_are_disjoint_and_used_by_their_seeds(self):
-        train, val = scenes.texture_pool('train'), scenes.texture_pool('val')
+        train, val = textures.texture_pool('train'), textures.texture_pool('val')
         self.assertFalse(set(train.paths) & set(val.paths))
         for seed, pool in ((5, train), (10 ** 9 + 5, val)):
             with self.subTest(seed=seed):
                 owned = {id(p) for p in pool.pyramids}
-                used = {id(o.material.pyramid) for o in scenes.sample_scene(seed, *SMALL).objects
+                used = {id(o.material.pyramid) for o in scene_sampler.sample_scene(seed, *SMALL).objects
                         if o.material.pyramid is not None}
                 self.assertTrue(used)
                 self.assertLessEqual(used, owned)
 
     def test_bad_paths_are_named_in_the_error(self):
         with self.assertRaisesRegex(ValueError, 'notes.txt'):
-            scenes.photo_split(scenes.photo_root() / 'kodak24' / 'notes.txt')
+            photo_folder.photo_split(photo_folder.photo_root() / 'kodak24' / 'notes.txt')
         with tempfile.TemporaryDirectory() as empty:
             missing = os.path.join(empty, 'nowhere')
             with self.assertRaisesRegex(RuntimeError, 'nowhere'):
-                scenes.list_photos(root=missing)
+                photo_folder.list_photos(root=missing)
             with self.assertRaisesRegex(RuntimeError, 'no train photos'):
-                scenes.list_photos('train', root=empty)
+                photo_folder.list_photos('train', root=empty)
 
 
 class Dataset(unittest.TestCase):

@@ -65,7 +65,8 @@ def to_tensors(rgb, disparity):
 
 
 class SceneSource:
-    """Procedural scenes by seed (issue 5's generator, training/scenes.py)."""
+    """Procedural scenes by seed (training/scenes.py): exact disparity, and validation seeds
+    textured only with validation photos."""
 
     def __init__(self, size):
         import scenes  # the generator lives beside this file
@@ -314,9 +315,9 @@ def train(args):
     source = make_source(args.data, size)
     ordinal_train = ordinal_val = None
     if args.ordinal:
-        import scenes  # the photo folder
-        ordinal_train = ordinal_data.load_split("train", scenes.photo_root(), args.ordinal)
-        ordinal_val = ordinal_data.load_split("val", scenes.photo_root(), args.ordinal)
+        import photo_folder  # the photo folder
+        ordinal_train = ordinal_data.load_split("train", photo_folder.photo_root(), args.ordinal)
+        ordinal_val = ordinal_data.load_split("val", photo_folder.photo_root(), args.ordinal)
     best_of = "ordinal_whdr" if ordinal_val else "val_loss"  # what best.pt keeps the lowest of
     ckpt_path = run / "checkpoint.pt"
     model = initial_model(args, source, size, resuming=ckpt_path.exists())

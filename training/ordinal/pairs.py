@@ -28,7 +28,7 @@ import numpy as np
 from PIL import Image, ImageDraw, ImageFilter, ImageFont, ImageOps
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-import scenes  # noqa: E402  (the photo listing and the split)
+import photo_folder  # noqa: E402  (the photo listing and the split)
 
 HERE = Path(__file__).resolve().parent
 PAIRS_FILE = HERE / 'pairs.json'
@@ -116,7 +116,7 @@ def sample_photo(path, rel):
         rng = photo_rng(rel, round_no)
         pairs += [('random', a, b) for a, b in random_pairs(rng, w, h, RANDOM_PAIRS)]
         pairs += [('edge', a, b) for a, b in edge_pairs(rng, gray, EDGE_PAIRS)]
-    return {'photo': rel, 'width': w, 'height': h, 'split': scenes.ordinal_split(path),
+    return {'photo': rel, 'width': w, 'height': h, 'split': photo_folder.ordinal_split(path),
             'pairs': [{'id': i + 1, 'kind': kind,
                        'a': [round(float(a[0]), 1), round(float(a[1]), 1)],
                        'b': [round(float(b[0]), 1), round(float(b[1]), 1)]}
@@ -124,8 +124,8 @@ def sample_photo(path, rel):
 
 
 def cmd_sample(args):
-    root = scenes.photo_root()
-    photos = [sample_photo(p, p.relative_to(root).as_posix()) for p in scenes.list_photos()]
+    root = photo_folder.photo_root()
+    photos = [sample_photo(p, p.relative_to(root).as_posix()) for p in photo_folder.list_photos()]
     PAIRS_FILE.write_text(json.dumps({'seed': SEED, 'photos': photos}, indent=1) + '\n')
     n = sum(len(p['pairs']) for p in photos)
     print(f'{PAIRS_FILE}: {n} pairs on {len(photos)} photos')
@@ -191,7 +191,7 @@ def zoom_crop(photo, pair, size=(480, 300)):
 
 
 def cmd_draw(args):
-    root = scenes.photo_root()
+    root = photo_folder.photo_root()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     entries = json.loads(PAIRS_FILE.read_text())['photos']

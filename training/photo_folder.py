@@ -1,0 +1,90 @@
+"""The photo folder and its fixed train/validation splits.
+
+The photos (../shared/data/photos, or $AMPI_PHOTO_ROOT) are never copied into the
+repository. Splits go by a photo's place in its folder's sorted names, so that a copy of
+the folder with the same names (gpu_run.py's downscaled one) splits the same way: every
+tenth photo is validation (photo_split), every fifth is the real-photo ordinal validation
+(ordinal_split, a superset of the former). Scene seeds split too (is_validation_seed):
+validation scenes are textured only with validation photos.
+"""
+
+import functools
+import os
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+PHOTO_SUFFIXES = {'.jpg', '.jpeg', '.png'}
+DEFAULT_PHOTO_ROOT = Path(__file__).resolve().parents[2] / 'shared' / 'data' / 'photos'
+VALIDATION_SEED_START = 10 ** 9
+VALIDATION_PHOTO_PERIOD = 10      # every tenth photo of a folder (by sorted name) is validation
+ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validation (training/ordinal)
+
+
+def is_validation_seed(seed):
+    """Seeds from 10**9 up are the fixed synthetic validation set, never trained on."""
+    return seed >= VALIDATION_SEED_START
+
+
+@functools.lru_cache(maxsize=None)
+def _photo_names(folder):
+    try:
+        entries = list(Path(folder).iterdir())
+    except OSError as error:
+        raise RuntimeError(f'{folder}: cannot list photos ({error.strerror})') from error
+    return tuple(sorted(p.name for p in entries if p.suffix.lower() in PHOTO_SUFFIXES))
+
+
+def _every_nth_of_folder(path, period):
+    """True for every period-th photo of its folder by sorted name (indices period - 1,
+    2 period - 1, ...)."""
+    path = Path(path)
+    names = _photo_names(str(path.resolve().parent))
+    if path.name not in names:
+        raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
+    return names.index(path.name) % period == period - 1
+
+
+def photo_split(path):
+    """'val' for every tenth photo of its folder by sorted name, else 'train'."""
+    return 'val' if _every_nth_of_folder(path, VALIDATION_PHOTO_PERIOD) else 'train'
+
+
+def ordinal_split(path):
+    """'val' for every fifth photo of its folder by sorted name (the synthetic validation
+    photos and as many more), else 'train'. Ordinal validation photos are never trained on:
+    not ranked, and not textures of training scenes either."""
+    return 'val' if _every_nth_of_folder(path, ORDINAL_VALIDATION_PERIOD) else 'train'
+
+
+def photo_root():
+    return Path(os.environ.get('AMPI_PHOTO_ROOT', DEFAULT_PHOTO_ROOT))
+
+
+def list_photos(split=None, root=None):
+    """Sorted photo paths under root (default: $AMPI_PHOTO_ROOT or ../shared/data/photos)."""
+    root = Path(root) if root is not None else photo_root()
+    if not root.is_dir():
+        raise RuntimeError(f'{root}: photo folder not found (set AMPI_PHOTO_ROOT)')
+    paths = sorted(p for p in root.rglob('*') if p.suffix.lower() in PHOTO_SUFFIXES)
+    if split is not None:
+        paths = [p for p in paths if photo_split(p) == split]
+    if not paths:
+        raise RuntimeError(f'{root}: no {split or ""} photos found'.replace('  ', ' '))
+    return paths
+
+
+def load_photo(path, max_side):
+    """RGB uint8 array, downscaled so that its longer side is at most max_side."""
+    try:
+        with Image.open(path) as image:
+            image.draft('RGB', (max_side, max_side))   # JPEG: decode at a reduced DCT scale
+            image = image.convert('RGB')
+            scale = max_side / max(image.size)
+            if scale < 1:
+                size = (max(1, round(image.width * scale)), max(1, round(image.height * scale)))
+                image = image.resize(size, Image.BILINEAR, reducing_gap=2.0)
+            return np.asarray(image, dtype=np.uint8)
+    except OSError as error:
+        raise RuntimeError(f'{path}: cannot decode photo ({error})') from error
