@@ -46,6 +46,14 @@ def weight_file_seeds():
         write("weight_file", "small.ampw", f.read())
 
 
+def network_seeds():
+    """The tiny depth and inpainting networks of the test fixtures (written by
+    tests/fixtures/nets/make_loader_fixtures.py and training/export_inpaint.py)."""
+    for name, path in (("tiny-depth.ampw", ("nets", "tiny_depth.ampw")), ("tiny-inpaint.ampw", ("inpaint", "tiny.ampw"))):
+        with open(os.path.join(ROOT, "tests", "fixtures", *path), "rb") as f:
+            write("networks", name, f.read())
+
+
 def npy_seeds():
     source = os.path.join(ROOT, "tests", "weights_format", "npy")
     for name in sorted(os.listdir(source)):
@@ -102,13 +110,14 @@ def keyframes_seeds():
 
 
 def main():
-    for target in ("weight_file", "npy", "mpi_json", "depth_map", "photo", "keyframes"):
+    for target in ("weight_file", "networks", "npy", "mpi_json", "depth_map", "photo", "keyframes"):
         folder = os.path.join(CORPUS, target)
         if os.path.isdir(folder):
             for name in os.listdir(folder):
                 if name.startswith("seed-"):
                     os.remove(os.path.join(folder, name))
     weight_file_seeds()
+    network_seeds()
     npy_seeds()
     mpi_json_seeds()
     depth_map_seeds()

@@ -15,7 +15,7 @@ cd "$(dirname "$0")/.."
 jobs=$(nproc)
 fuzz_seconds=${AMPI_FUZZ_SECONDS:-20}
 only=${AMPI_RELIABILITY_ONLY:-}
-fuzz_targets=(weight_file npy mpi_json depth_map photo keyframes)
+fuzz_targets=(weight_file networks npy mpi_json depth_map photo keyframes)
 # -O1: the sanitizers' usual level (fast enough, readable reports); -g1: source lines.
 # GCC's -Wmaybe-uninitialized misfires on sanitizer-instrumented code (in libstdc++'s
 # <regex> here), so the sanitizer builds leave it out.
