@@ -23,7 +23,8 @@ fs::path executable_dir() {
 
 std::vector<fs::path> weight_folders() {
   if (const char* env = std::getenv("AMPI_WEIGHTS_DIR"); env && *env) return {env};
-  if (const fs::path dir = executable_dir(); !dir.empty()) return {dir / "weights", dir.parent_path() / "weights"};
+  if (const fs::path dir = executable_dir(); !dir.empty())
+    return {dir / "weights", dir.parent_path() / "weights", dir.parent_path() / "share" / "ampi" / "weights"};
   return {};
 }
 

@@ -3,9 +3,11 @@
 //
 // The folder is the one named by the environment variable AMPI_WEIGHTS_DIR (when set, the
 // only place looked), else weights/ beside the executable or one level above it (a build
-// folder inside the source tree: build/ampi finds ../weights/). Files are told apart by
-// their metadata, never by their names: a depth model is the depth-network file whose
-// model name (nets/model_loader.h, model_name) is the one asked for.
+// folder inside the source tree: build/ampi finds ../weights/), else share/ampi/weights/
+// one level above it (an installed /usr/bin/ampi finds /usr/share/ampi/weights/). Files
+// are told apart by their metadata, never by their names: a depth model is the
+// depth-network file whose model name (nets/model_loader.h, model_name) is the one asked
+// for.
 #pragma once
 #include <string>
 #include <vector>
