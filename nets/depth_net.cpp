@@ -1,7 +1,6 @@
 #include "nets/depth_net.h"
 
 #include <algorithm>
-#include <cmath>
 #include <memory>
 #include <optional>
 #include <stdexcept>

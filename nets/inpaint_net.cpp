@@ -1,7 +1,5 @@
 #include "nets/inpaint_net.h"
 
-#include <algorithm>
-#include <cmath>
 #include <sstream>
 #include <stdexcept>
 
