@@ -267,6 +267,26 @@ WeightFile WeightFile::open(const std::string& path) { return from_bytes(read_am
 WeightFile WeightFile::from_bytes(std::vector<uint8_t> bytes, const std::string& origin) {
   WeightFile wf;
   wf.path_ = origin;
+  wf.file_size_ = bytes.size();
+  wf.bytes_ = std::make_shared<const std::vector<uint8_t>>(std::move(bytes));
+  wf.parse();
+  return wf;
+}
+
+WeightFile WeightFile::open_header(const std::string& path) {
+  InputFile file(path);
+  std::vector<uint8_t> bytes(std::min<uint64_t>(file.size(), kPreambleBytes));
+  file.read(bytes.data(), bytes.size());
+  check_identity(bytes.data(), file.size(), path);
+  // parse() refuses a header that does not fit the file before it reads past the preamble
+  const uint64_t header_bytes = load_le(bytes.data() + 16, 8);
+  const uint64_t wanted = header_bytes <= file.size() - kChecksumBytes ? header_bytes + kChecksumBytes : kPreambleBytes;
+  bytes.resize(std::max<uint64_t>(wanted, kPreambleBytes));
+  file.read(bytes.data() + kPreambleBytes, bytes.size() - kPreambleBytes);
+  WeightFile wf;
+  wf.path_ = path;
+  wf.file_size_ = file.size();
+  wf.header_only_ = true;
   wf.bytes_ = std::make_shared<const std::vector<uint8_t>>(std::move(bytes));
   wf.parse();
   return wf;
@@ -278,9 +298,8 @@ void WeightFile::fail(const std::string& problem) const { fail_at(path_, problem
 // is reported as damaged, not by whichever field the damage hit), then the header's
 // contents, then the data section against the file, then the tensors' checksums.
 void WeightFile::parse() {
-  const std::vector<uint8_t>& file = *bytes_;
-  const uint8_t* p = file.data();
-  const uint64_t size = file.size();
+  const uint8_t* p = bytes_->data();
+  const uint64_t size = file_size_;
   check_identity(p, size, path_);
   version_major_ = static_cast<int>(load_le(p + 4, 2));
   version_minor_ = static_cast<int>(load_le(p + 6, 2));
@@ -325,7 +344,7 @@ void WeightFile::parse() {
   if (data_bytes < size - data_offset)
     fail(std::to_string(size - data_offset - data_bytes) + " unexpected bytes after the data section");
   check_overlaps();
-  check_tensor_checksums();
+  if (!header_only_) check_tensor_checksums();
 }
 
 size_t WeightFile::parse_metadata(size_t pos, uint32_t count, size_t header_end) {
@@ -470,6 +489,7 @@ const TensorInfo* WeightFile::find(const std::string& name) const {
 Tensor WeightFile::tensor(const std::string& name, const Shape& expected) const {
   const TensorInfo* info = find(name);
   if (!info) fail("no tensor named '" + name + "'");
+  if (header_only_) fail("tensor '" + name + "': only the header was read");
   if (info->shape != expected)
     fail("tensor '" + name + "' has shape " + shape_str(info->shape) + ", expected " + shape_str(expected));
   const uint8_t* src = bytes_->data() + info->offset;

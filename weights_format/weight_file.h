@@ -59,6 +59,10 @@ class WeightFile {
   // The same for a file image already in memory (tests, fuzzing); `origin` names it in
   // error messages.
   static WeightFile from_bytes(std::vector<uint8_t> bytes, const std::string& origin);
+  // Reads only the preamble and the header (metadata and tensor table), checked as open()
+  // checks them and against the file's real size, but not the tensor data: finding a
+  // file by its metadata costs its header, not its weights. tensor() on it throws.
+  static WeightFile open_header(const std::string& path);
 
   const std::string& path() const { return path_; }
   int version_major() const { return version_major_; }
@@ -101,6 +105,8 @@ class WeightFile {
   [[noreturn]] void fail(const std::string& problem) const;
 
   std::string path_;
+  uint64_t file_size_ = 0;    // bytes_->size(), or more when only the header was read
+  bool header_only_ = false;
   int version_major_ = 0;
   int version_minor_ = 0;
   std::vector<MetaEntry> metadata_;
