@@ -20,7 +20,7 @@ using LayerFiller =
 LayerFiller push_pull_filler();
 LayerFiller harmonic_filler();
 
-// The fillers a user picks by name (--inpainter): the network (inpaint/inpaint_net.h),
+// The fillers a user picks by name (--inpainter): the network (inpaint/net_filler.h),
 // "harmonic" or "push-pull".
 enum class Inpainter { Network, Harmonic, PushPull };
 // Throws std::runtime_error "--inpainter: 'NAME' is not network, harmonic or push-pull".

@@ -1,7 +1,7 @@
 """Exports the inpainting generator to an .ampw file for the C++ engine, and writes the
 parity fixtures the C++ tests compare against.
 
-File contents (read by inpaint/inpaint_net.cpp):
+File contents (read by nets/inpaint_net.cpp):
   metadata  arch = "ampi.inpaint.gated-conv", inpaint.version (1: hole zeroed, output the fill;
             2: hole pre-filled by the fill named in inpaint.prefill, output a residual
             on it inside the hole; training/inpaint_model.py), the graph of

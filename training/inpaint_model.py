@@ -28,7 +28,7 @@ that is not opaque (the margin to fill and the transparent rest), in training ev
 outside the eroded layer mask. Only the pixels with ground truth are supervised.
 
 The architecture is data (LAYERS): the exporter writes it into the weight file and the
-C++ network (inpaint/inpaint_net.cpp) builds the same graph from it.
+C++ network (nets/inpaint_net.cpp) builds the same graph from it.
 """
 from __future__ import annotations
 
