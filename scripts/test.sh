@@ -10,10 +10,12 @@ cmake -S . -B build -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j"$jobs"
 ctest --test-dir build --output-on-failure -j"$jobs"
 
-# aarch64: the inference core (engine, kernels, weights_format, nets; no OpenCV) cross
-# built with g++-aarch64-linux-gnu. ctest runs each test binary under qemu-aarch64 (the
-# toolchain's CMAKE_CROSSCOMPILING_EMULATOR), which makes NEON the best ISA there; qemu is
-# about 150x slower on float code, so the tests take their small shapes.
+# aarch64: the inference core (engine, kernels, weights_format, nets, and the slicer's and
+# the compositor's SIMD kernels; no OpenCV) cross built with g++-aarch64-linux-gnu. ctest
+# runs each test binary under qemu-aarch64 (the toolchain's CMAKE_CROSSCOMPILING_EMULATOR),
+# which makes NEON the best ISA there: the kernels test (tests/kernels/) holds every SIMD
+# family's NEON-against-scalar checks. qemu is about 150x slower on float code, so the
+# tests take their small shapes.
 cmake -S . -B build-aarch64 -DCMAKE_BUILD_TYPE=Release \
   -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake -DAMPI_WITH_OPENCV=OFF
 cmake --build build-aarch64 -j"$jobs"
