@@ -2,7 +2,10 @@
 // each in a file of its own (fma_loop_ISA.cpp) that cmake/isa.cmake compiles with that
 // ISA's flags, as it does every kernel. Each runs `iterations` steps of kFmaChains
 // independent chains acc = acc * kFmaMul + kFmaAdd, all lanes of the ISA's widest
-// register, and returns a value that depends on every chain, so no work can be dropped.
+// register, chain j starting at start + 0.01 j, and returns a value that depends on every
+// chain, so no work can be dropped. The caller passes a start the compiler cannot know:
+// from constants it could run the chains at compile time (1.0 is a fixed point of the
+// step in float) and drop the loop.
 #pragma once
 #include <cstdint>
 
@@ -15,13 +18,13 @@ constexpr int kFmaChains = 12;
 constexpr float kFmaMul = 0.9999999f, kFmaAdd = 1e-7f;
 
 namespace avx2 {
-float fma_loop(int64_t iterations);  // 8 lanes
+float fma_loop(int64_t iterations, float start);  // 8 lanes
 }
 namespace avx512 {
-float fma_loop(int64_t iterations);  // 16 lanes
+float fma_loop(int64_t iterations, float start);  // 16 lanes
 }
 namespace neon {
-float fma_loop(int64_t iterations);  // 4 lanes
+float fma_loop(int64_t iterations, float start);  // 4 lanes
 }
 
 }  // namespace ampi::bench

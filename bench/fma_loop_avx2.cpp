@@ -4,9 +4,9 @@
 
 namespace ampi::bench::avx2 {
 
-float fma_loop(int64_t iterations) {
+float fma_loop(int64_t iterations, float start) {
   __m256 acc[kFmaChains];
-  for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm256_set1_ps(1.0f + 0.01f * j);
+  for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm256_set1_ps(start + 0.01f * j);
   const __m256 mul = _mm256_set1_ps(kFmaMul), add = _mm256_set1_ps(kFmaAdd);
   for (int64_t i = 0; i < iterations; ++i)
     for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm256_fmadd_ps(acc[j], mul, add);

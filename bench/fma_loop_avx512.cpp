@@ -4,9 +4,9 @@
 
 namespace ampi::bench::avx512 {
 
-float fma_loop(int64_t iterations) {
+float fma_loop(int64_t iterations, float start) {
   __m512 acc[kFmaChains];
-  for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm512_set1_ps(1.0f + 0.01f * j);
+  for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm512_set1_ps(start + 0.01f * j);
   const __m512 mul = _mm512_set1_ps(kFmaMul), add = _mm512_set1_ps(kFmaAdd);
   for (int64_t i = 0; i < iterations; ++i)
     for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm512_fmadd_ps(acc[j], mul, add);

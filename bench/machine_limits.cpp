@@ -19,16 +19,16 @@ constexpr int64_t kIterations = 40'000'000;
 
 // Returns a value that depends on every chain, so no work can be dropped. It must stay
 // scalar: that is what the scalar table's code can use.
-__attribute__((optimize("no-tree-vectorize"))) float scalar_fma_loop(int64_t iterations) {
+__attribute__((optimize("no-tree-vectorize"))) float scalar_fma_loop(int64_t iterations, float start) {
   float acc[kFmaChains];
-  for (int j = 0; j < kFmaChains; ++j) acc[j] = 1.0f + 0.01f * j;
+  for (int j = 0; j < kFmaChains; ++j) acc[j] = start + 0.01f * j;
   for (int64_t i = 0; i < iterations; ++i)
     for (int j = 0; j < kFmaChains; ++j) acc[j] = acc[j] * kFmaMul + kFmaAdd;
   return std::accumulate(acc, acc + kFmaChains, 0.0f);
 }
 
 struct FmaLoop {
-  float (*run)(int64_t iterations);
+  float (*run)(int64_t iterations, float start);
   int lanes;
 };
 
@@ -47,6 +47,8 @@ FmaLoop fma_loop_for(Isa isa) {
 
 // Keeps the loops' results observable.
 volatile float g_sink;
+// The chains' start, read at run time so the compiler cannot fold the loops (fma_loop.h).
+volatile float g_fma_start = 1.0f;
 
 }  // namespace
 
@@ -76,7 +78,7 @@ double fma_peak_gflops(Isa isa, ThreadPool& pool, int runs, Clock clock) {
     const Stopwatch watch(clock, pool.size());
     // One index per thread: each runs the loop once.
     pool.parallel_for(threads, 1, [&](int64_t first, int64_t last) {
-      for (int64_t t = first; t < last; ++t) results[t] = loop.run(kIterations);
+      for (int64_t t = first; t < last; ++t) results[t] = loop.run(kIterations, g_fma_start);
     });
     const double flops = 2.0 * kIterations * kFmaChains * loop.lanes * threads;
     rates.push_back(flops / watch.seconds() * 1e-9);
