@@ -1,5 +1,10 @@
-// Benchmarks behind `ampi bench WHAT`. Each takes its own argv (argv[0] = WHAT),
-// prints a table and writes it to bench/RESULTS-WHAT.md.
+// Benchmarks behind `ampi bench WHAT` (cli/cmd_bench.cpp) and the timing helpers they
+// share. Each prints its results and writes its table into the repository (bench/).
+// bench/ never includes cli/: the network and pipeline benchmarks take their options as
+// structs (network_bench.h, pipeline_bench.h) that cli/cmd_bench.cpp parses the way the
+// other subcommands parse theirs (--model, --weights, --inpainter, --working-size as in
+// ampi depth and ampi run); kernels and render read their own few options from argv
+// (argv[0] = WHAT).
 #pragma once
 #include <algorithm>
 #include <chrono>
@@ -29,14 +34,5 @@ int kernels_benchmark(int argc, char** argv);
 // ampi bench render [--frames N] [--naive-frames N] [--size WxH] [--planes N] [--out FILE]:
 // the tiled compositor against the naive one, 2 threads and 1 (render_bench.cpp).
 int render_benchmark(int argc, char** argv);
-
-// ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N] [--out FILE]:
-// per-stage times of `ampi run` and peak memory at 1024x768 and 4K (pipeline_bench.cpp).
-int pipeline_benchmark(int argc, char** argv);
-
-// ampi bench network --input RGB.npy [--model NAME] [--threads LIST] [--runs N]
-// [--save PREFIX]: DepthModel::run alone, one JSON line per thread count; the ampi side of
-// the peer benchmark, bench/peers/run.sh (network_bench.cpp).
-int network_benchmark(int argc, char** argv);
 
 }  // namespace ampi::bench

@@ -8,86 +8,38 @@
 #include <vector>
 
 #include "bench/bench.h"
+#include "bench/fma_loop.h"
 #include "engine/tensor.h"
-
-#if defined(AMPI_ARCH_X86)
-#include <immintrin.h>
-#elif defined(AMPI_ARCH_ARM64)
-#include <arm_neon.h>
-#endif
 
 namespace ampi::bench {
 namespace {
 
-// Independent accumulator chains: more than FMA latency x FMA ports (4 x 2 on current
-// cores), so the loop runs at FMA throughput, and few enough to stay in registers.
-constexpr int kChains = 12;
 // Loop iterations per thread per timed run: 480M FMAs, a tenth of a second or so.
 constexpr int64_t kIterations = 40'000'000;
-// Multiplier and addend keep the accumulators finite and normal for any run length.
-constexpr float kMul = 0.9999999f, kAdd = 1e-7f;
 
-// Each loop returns a value that depends on every chain, so no work can be dropped.
-// The scalar loop must stay scalar: that is what the scalar table's code can use.
-__attribute__((optimize("no-tree-vectorize"))) float scalar_fma_loop(int64_t iterations) {
-  float acc[kChains];
-  for (int j = 0; j < kChains; ++j) acc[j] = 1.0f + 0.01f * j;
+// Returns a value that depends on every chain, so no work can be dropped. It must stay
+// scalar: that is what the scalar table's code can use.
+__attribute__((optimize("no-tree-vectorize"))) float scalar_fma_loop(int64_t iterations, float start) {
+  float acc[kFmaChains];
+  for (int j = 0; j < kFmaChains; ++j) acc[j] = start + 0.01f * j;
   for (int64_t i = 0; i < iterations; ++i)
-    for (int j = 0; j < kChains; ++j) acc[j] = acc[j] * kMul + kAdd;
-  return std::accumulate(acc, acc + kChains, 0.0f);
+    for (int j = 0; j < kFmaChains; ++j) acc[j] = acc[j] * kFmaMul + kFmaAdd;
+  return std::accumulate(acc, acc + kFmaChains, 0.0f);
 }
-
-#if defined(AMPI_ARCH_X86)
-__attribute__((target("avx2,fma"))) float avx2_fma_loop(int64_t iterations) {
-  __m256 acc[kChains];
-  for (int j = 0; j < kChains; ++j) acc[j] = _mm256_set1_ps(1.0f + 0.01f * j);
-  const __m256 mul = _mm256_set1_ps(kMul), add = _mm256_set1_ps(kAdd);
-  for (int64_t i = 0; i < iterations; ++i)
-    for (int j = 0; j < kChains; ++j) acc[j] = _mm256_fmadd_ps(acc[j], mul, add);
-  for (int j = 1; j < kChains; ++j) acc[0] = _mm256_add_ps(acc[0], acc[j]);
-  alignas(32) float lanes[8];
-  _mm256_store_ps(lanes, acc[0]);
-  return std::accumulate(lanes, lanes + 8, 0.0f);
-}
-
-__attribute__((target("avx512f"))) float avx512_fma_loop(int64_t iterations) {
-  __m512 acc[kChains];
-  for (int j = 0; j < kChains; ++j) acc[j] = _mm512_set1_ps(1.0f + 0.01f * j);
-  const __m512 mul = _mm512_set1_ps(kMul), add = _mm512_set1_ps(kAdd);
-  for (int64_t i = 0; i < iterations; ++i)
-    for (int j = 0; j < kChains; ++j) acc[j] = _mm512_fmadd_ps(acc[j], mul, add);
-  for (int j = 1; j < kChains; ++j) acc[0] = _mm512_add_ps(acc[0], acc[j]);
-  alignas(64) float lanes[16];
-  _mm512_store_ps(lanes, acc[0]);
-  return std::accumulate(lanes, lanes + 16, 0.0f);
-}
-#endif
-
-#if defined(AMPI_ARCH_ARM64)
-float neon_fma_loop(int64_t iterations) {
-  float32x4_t acc[kChains];
-  for (int j = 0; j < kChains; ++j) acc[j] = vdupq_n_f32(1.0f + 0.01f * j);
-  const float32x4_t mul = vdupq_n_f32(kMul), add = vdupq_n_f32(kAdd);
-  for (int64_t i = 0; i < iterations; ++i)
-    for (int j = 0; j < kChains; ++j) acc[j] = vfmaq_f32(add, acc[j], mul);
-  for (int j = 1; j < kChains; ++j) acc[0] = vaddq_f32(acc[0], acc[j]);
-  return vaddvq_f32(acc[0]);
-}
-#endif
 
 struct FmaLoop {
-  float (*run)(int64_t iterations);
+  float (*run)(int64_t iterations, float start);
   int lanes;
 };
 
 FmaLoop fma_loop_for(Isa isa) {
   switch (isa) {
 #if defined(AMPI_ARCH_X86)
-    case Isa::Avx2: return {avx2_fma_loop, 8};
-    case Isa::Avx512: return {avx512_fma_loop, 16};
+    case Isa::Avx2: return {avx2::fma_loop, 8};
+    case Isa::Avx512: return {avx512::fma_loop, 16};
 #endif
 #if defined(AMPI_ARCH_ARM64)
-    case Isa::Neon: return {neon_fma_loop, 4};
+    case Isa::Neon: return {neon::fma_loop, 4};
 #endif
     default: return {scalar_fma_loop, 1};
   }
@@ -95,6 +47,8 @@ FmaLoop fma_loop_for(Isa isa) {
 
 // Keeps the loops' results observable.
 volatile float g_sink;
+// The chains' start, read at run time so the compiler cannot fold the loops (fma_loop.h).
+volatile float g_fma_start = 1.0f;
 
 }  // namespace
 
@@ -124,9 +78,9 @@ double fma_peak_gflops(Isa isa, ThreadPool& pool, int runs, Clock clock) {
     const Stopwatch watch(clock, pool.size());
     // One index per thread: each runs the loop once.
     pool.parallel_for(threads, 1, [&](int64_t first, int64_t last) {
-      for (int64_t t = first; t < last; ++t) results[t] = loop.run(kIterations);
+      for (int64_t t = first; t < last; ++t) results[t] = loop.run(kIterations, g_fma_start);
     });
-    const double flops = 2.0 * kIterations * kChains * loop.lanes * threads;
+    const double flops = 2.0 * kIterations * kFmaChains * loop.lanes * threads;
     rates.push_back(flops / watch.seconds() * 1e-9);
     g_sink = std::accumulate(results.begin(), results.end(), 0.0f);
   }

@@ -1,5 +1,5 @@
-// ampi bench pipeline: where the time and the memory of `ampi run` go, stage by stage,
-// at 1024x768 and at 4K, on the bundled example photo resized to each size.
+#include "bench/pipeline_bench.h"
+
 #include <unistd.h>
 
 #include <algorithm>
@@ -16,14 +16,12 @@
 #include <vector>
 
 #include "bench/bench.h"
-#include "cli/args.h"
 #include "engine/thread_pool.h"
 #include "mpi/mpi_io.h"
-#include "nets/model_loader.h"
 #include "nets/bundled_weights.h"
+#include "nets/model_loader.h"
 #include "pipeline/depth_estimate.h"
 #include "pipeline/full_resolution.h"
-#include "pipeline/make_mpi.h"
 #include "pipeline/photo_io.h"
 #include "pipeline/video.h"
 #include "slicing/adaptive.h"
@@ -32,25 +30,6 @@ namespace fs = std::filesystem;
 
 namespace ampi::bench {
 namespace {
-
-const char kUsage[] =
-    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
-    "                           [--inpainter network|harmonic|push-pull] [--working-size N] [--out FILE]\n"
-    "\n"
-    "Times every stage of `ampi run` (decode, depth, depth edges, slicing, assembly,\n"
-    "inpainting, MPI write, render + encode of the video) on PHOTO resized to 1024x768 and\n"
-    "to 3840x2160, medians of N runs, and each stage's peak resident memory. Also slicing's\n"
-    "time as a share of the depth network's (both run at the same working resolution), and\n"
-    "photo to MPI with and without depth edges, run by run. Writes the table to\n"
-    "bench/RESULTS-pipeline.md.\n"
-    "\n"
-    "  --photo FILE   default examples/forest_path.jpg\n"
-    "  --runs N       runs per size (default 3)\n"
-    "  --threads N    worker threads (default 2)\n"
-    "  --frames N     video frames rendered and encoded per run (default 30)\n"
-    "  --inpainter NAME      network (default, as ampi run), harmonic or push-pull\n"
-    "  --working-size N      the depth network's long side (default: the weight file's)\n"
-    "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
 struct SizeResult {
   cv::Size size;
@@ -150,9 +129,9 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
   return r;
 }
 
-// Issue 6's comparison like for like: the depth network alone on the photo already shrunk
-// to the working size, and the slicer on its output, each timed warm, alternately, `reps`
-// times (medians). The run's stage times differ: there the slicer's buffers are touched
+// Slicing's cost against the depth network's, like for like: the network alone on the
+// photo already shrunk to the working size, and the slicer on its output, each timed
+// warm, alternately, `reps` times (medians). The run's stage times differ: there the slicer's buffers are touched
 // for the first time after the heap was handed back (page faults), while the network's
 // arena persists, and the depth stage includes shrinking the photo.
 void measure_slicing_share(const cv::Mat& source, const MpiOptions& options, int reps, SizeResult& r) {
@@ -185,12 +164,12 @@ double median_of(const SizeResult& r, const std::string& stage) {
   return r.ms.count(stage) ? median(r.ms.at(stage)) : 0;
 }
 
-// Issue 6's target: slicing costs at most this share of the depth network's time at the
-// same resolution.
+// Slicing must stay a small part of making the depth: at most this share of the depth
+// network's time at the same resolution.
 constexpr double kSlicingShareTarget = 0.05;
 constexpr int kSlicingShareReps = 30;
-// Issue 25's target: depth edges that follow the photo add at most this share to the
-// photo-to-MPI time.
+// Depth edges that follow the photo must be nearly free: they add at most this share to
+// the photo-to-MPI time.
 constexpr double kEdgeGrowthTarget = 0.10;
 
 std::string table(const std::vector<SizeResult>& results, const MpiOptions& options, int threads,
@@ -276,42 +255,29 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
 
 }  // namespace
 
-int pipeline_benchmark(int argc, char** argv) {
-  std::string photo = "examples/forest_path.jpg", out = "bench/RESULTS-pipeline.md";
-  int runs = 3, threads = 2, frames = 30;
-  MpiOptions options;
-  cli::ArgParser p("bench pipeline", kUsage);
-  p.option("--photo", &photo);
-  p.option("--runs", &runs, 1, 100);
-  p.option("--threads", &threads, 1, 256);
-  p.option("--frames", &frames, 1, 10000);
-  p.option("--out", &out);
-  p.option("--inpainter", [&](const std::string& v) { options.inpainter = parse_inpainter(v); });
-  p.option("--working-size", &options.working_size, kMinPhotoSide, 16384);
-  if (!p.parse(argc, argv)) return 0;
-  set_default_threads(threads);
-
-  const cv::Mat source = read_photo(photo);
+int pipeline_benchmark(const PipelineBenchOptions& o) {
+  set_default_threads(o.threads);
+  const cv::Mat source = read_photo(o.photo);
   VideoOptions video;
-  video.path.frames = frames;
+  video.path.frames = o.frames;
   const fs::path scratch = fs::temp_directory_path() / ("ampi_bench_pipeline_" + std::to_string(getpid()));
   fs::create_directories(scratch);
   std::vector<SizeResult> results;
   try {
     for (cv::Size size : {cv::Size(1024, 768), cv::Size(3840, 2160)}) {
       std::fprintf(stderr, "ampi bench pipeline: %dx%d ...\n", size.width, size.height);
-      results.push_back(measure(source, size, runs, options, video, scratch));
-      measure_slicing_share(source, options, kSlicingShareReps, results.back());
+      results.push_back(measure(source, size, o.runs, o.mpi, video, scratch));
+      measure_slicing_share(source, o.mpi, kSlicingShareReps, results.back());
     }
   } catch (...) {
     fs::remove_all(scratch);
     throw;
   }
   fs::remove_all(scratch);
-  const std::string md = table(results, options, threads, frames, runs);
+  const std::string md = table(results, o.mpi, o.threads, o.frames, o.runs);
   std::fputs(md.c_str(), stdout);
-  std::ofstream(out) << md;
-  std::fprintf(stderr, "ampi bench pipeline: wrote %s\n", out.c_str());
+  std::ofstream(o.out) << md;
+  std::fprintf(stderr, "ampi bench pipeline: wrote %s\n", o.out.c_str());
   return 0;
 }
 

@@ -221,7 +221,8 @@ std::string cpu_model() {
   return u.machine;
 }
 
-// Issue 8's targets: at least 3x the naive compositor, at least 100 frames/s at 2 threads.
+// The renderer's speed targets, judged in every table: at least 3x the naive compositor,
+// at least 100 frames/s at 2 threads.
 std::string targets(const std::vector<Row>& rows) {
   double worst_ratio = HUGE_VAL, worst_fps = HUGE_VAL, worst_cpu_fps = HUGE_VAL;
   for (const Row& r : rows) {

@@ -1,13 +1,88 @@
 // ampi bench WHAT: latency benchmarks. Each benchmark lives in bench/ and writes its
-// table into the repository (bench/RESULTS-*.md) as well as to stdout.
+// table into the repository (bench/RESULTS-*.md) as well as to stdout. The network and
+// pipeline benchmarks' options are parsed here, with the parser of the other subcommands,
+// so bench/ needs nothing from cli/.
 #include <cstdio>
 #include <cstring>
+#include <stdexcept>
+#include <string>
 
 #include "bench/bench.h"
+#include "bench/network_bench.h"
+#include "bench/pipeline_bench.h"
+#include "cli/args.h"
 #include "cli/commands.h"
+#include "pipeline/photo_io.h"
 
 namespace ampi::cli {
 namespace {
+
+const char kNetworkUsage[] =
+    "usage: ampi bench network --input RGB.npy [--model NAME | --weights FILE]\n"
+    "                          [--threads LIST] [--runs N] [--warmup N] [--save PREFIX]\n"
+    "\n"
+    "Times DepthModel::run on one image: RGB.npy holds H x W x 3 float32 values in [0, 1]\n"
+    "(any H and W; the network pads them to its multiple and crops the output back).\n"
+    "For each thread count, runs N times after the warm-up runs and prints one line:\n"
+    "  {\"engine\": \"ampi\", \"model\": ..., \"isa\": ..., \"threads\": T, \"ms\": [...]}\n"
+    "bench/peers/run.sh uses it to compare ampi with ONNX Runtime, OpenCV DNN and PyTorch.\n"
+    "\n"
+    "  --model NAME     a bundled depth model by name: lite (default), heavy, ...\n"
+    "  --weights FILE   a depth weight file instead\n"
+    "  --threads LIST   comma-separated thread counts (default 1,2)\n"
+    "  --runs N         timed runs per thread count (default 5)\n"
+    "  --warmup N       untimed runs first (default 1; the first plans the arena)\n"
+    "  --save PREFIX    writes the output (H x W disparity) to PREFIX.tT.npy per count T\n";
+
+int bench_network(int argc, char** argv) {
+  bench::NetworkBenchOptions o;
+  std::string threads = "1,2";
+  ArgParser p("bench network", kNetworkUsage);
+  p.option("--input", &o.input);
+  p.option("--model", &o.model);
+  p.option("--weights", &o.weights);
+  p.option("--threads", &threads);
+  p.option("--runs", &o.runs, 1, 1000);
+  p.option("--warmup", &o.warmup, 0, 1000);
+  p.option("--save", &o.save);
+  if (!p.parse(argc, argv)) return 0;
+  if (o.input.empty()) throw std::runtime_error("network: --input RGB.npy is required");
+  o.threads = parse_int_list("--threads", threads, 1, 256, "a thread count");
+  return bench::network_benchmark(o);
+}
+
+const char kPipelineUsage[] =
+    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
+    "                           [--inpainter network|harmonic|push-pull] [--working-size N] [--out FILE]\n"
+    "\n"
+    "Times every stage of `ampi run` (decode, depth, depth edges, slicing, assembly,\n"
+    "inpainting, MPI write, render + encode of the video) on PHOTO resized to 1024x768 and\n"
+    "to 3840x2160, medians of N runs, and each stage's peak resident memory. Also slicing's\n"
+    "time as a share of the depth network's (both run at the same working resolution), and\n"
+    "photo to MPI with and without depth edges, run by run. Writes the table to\n"
+    "bench/RESULTS-pipeline.md.\n"
+    "\n"
+    "  --photo FILE   default examples/forest_path.jpg\n"
+    "  --runs N       runs per size (default 3)\n"
+    "  --threads N    worker threads (default 2)\n"
+    "  --frames N     video frames rendered and encoded per run (default 30)\n"
+    "  --inpainter NAME      network (default, as ampi run), harmonic or push-pull\n"
+    "  --working-size N      the depth network's long side (default: the weight file's)\n"
+    "  --out FILE     default bench/RESULTS-pipeline.md\n";
+
+int bench_pipeline(int argc, char** argv) {
+  bench::PipelineBenchOptions o;
+  ArgParser p("bench pipeline", kPipelineUsage);
+  p.option("--photo", &o.photo);
+  p.option("--runs", &o.runs, 1, 100);
+  p.option("--threads", &o.threads, 1, 256);
+  p.option("--frames", &o.frames, 1, 10000);
+  p.option("--out", &o.out);
+  p.option("--inpainter", [&](const std::string& v) { o.mpi.inpainter = parse_inpainter(v); });
+  p.option("--working-size", &o.mpi.working_size, kMinPhotoSide, 16384);
+  if (!p.parse(argc, argv)) return 0;
+  return bench::pipeline_benchmark(o);
+}
 
 struct Benchmark {
   const char* name;
@@ -18,8 +93,8 @@ struct Benchmark {
 const Benchmark kBenchmarks[] = {
     {"kernels", bench::kernels_benchmark, "convolution kernels vs the machine's FMA peak and memory bandwidth"},
     {"render", bench::render_benchmark, "MPI renderer frames/s vs the naive compositor (1024x768, 8 planes)"},
-    {"pipeline", bench::pipeline_benchmark, "ampi run stage by stage, peak memory (1024x768 and 4K)"},
-    {"network", bench::network_benchmark, "the depth network alone on an .npy image (bench/peers/run.sh: vs its peers)"},
+    {"pipeline", bench_pipeline, "ampi run stage by stage, peak memory (1024x768 and 4K)"},
+    {"network", bench_network, "the depth network alone on an .npy image (bench/peers/run.sh: vs its peers)"},
 };
 
 void usage(FILE* out) {

@@ -1,6 +1,6 @@
 // ampi eval MODE: reproduce the paper's evaluations on any folder of photos. One entry
 // per mode in kModes; each mode parses its own options and leaves the measuring to the
-// library (eval/, inpaint/eval_inpaint.h).
+// library (eval/).
 #include <algorithm>
 #include <cstdio>
 #include <cstring>
@@ -20,7 +20,7 @@
 #include "eval/depth_eval.h"
 #include "eval/ordinal_eval.h"
 #include "eval/slicing_eval.h"
-#include "inpaint/eval_inpaint.h"
+#include "eval/inpaint_eval.h"
 #include "inpaint/net_filler.h"
 #include "nets/bundled_weights.h"
 #include "nets/model_loader.h"

@@ -1,6 +1,17 @@
-# Per-instruction-set sources. Kernels for one ISA live in files named *_avx2.cpp,
-# *_avx512.cpp or *_neon.cpp; only those files get that ISA's compiler flags, so the
-# rest of the program stays portable and dispatch picks a variant at run time.
+# Per-instruction-set sources, the one way the project enables an instruction set. Code
+# for one ISA lives in files named *_avx2.cpp, *_avx512.cpp or *_neon.cpp (kernels/,
+# slicing/row_kernels_*, render/composite_*, bench/fma_loop_*); only those files get that
+# ISA's compiler flags, so the rest of the program stays portable and dispatch picks a
+# variant at run time. No source turns an ISA on by itself (no target pragma or
+# attribute), so what may run where can be read from the file names.
+#
+# The flags apply to everything such a file compiles, inline functions of the headers it
+# includes too: an inline or template function shared with other files (a std:: algorithm,
+# a container's method) that the compiler leaves out of line there is emitted with the
+# ISA's instructions, and the linker may keep that copy for the whole program. So per-ISA
+# files use intrinsics, helpers in their own ISA's namespace, and only std:: functions
+# small enough to be inlined everywhere (std::min, std::max): their objects' weak symbols
+# (`nm -C`) all belong to their own ISA's namespace.
 
 if(CMAKE_SYSTEM_PROCESSOR MATCHES "^(x86_64|AMD64|amd64)$")
   set(AMPI_ARCH_X86 ON)

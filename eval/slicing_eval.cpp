@@ -4,7 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "inpaint/eval_inpaint.h"
+#include "eval/inpaint_eval.h"
 #include "render/renderer.h"
 #include "render/trajectory.h"
 #include "slicing/adaptive.h"

@@ -16,7 +16,7 @@
 // planes they share sit at the same depths. Each is rendered at the same target poses
 // (a circle of the camera in the image plane, its radius `amplitude` times the nearest
 // reference plane's depth, as `ampi run --trajectory circle` moves); SSIM and PSNR of
-// each view against the reference's view at that pose (inpaint/eval_inpaint.h's
+// each view against the reference's view at that pose (eval/inpaint_eval.h's
 // full-frame metrics) are averaged over poses, then over photos.
 #pragma once
 #include <string>

@@ -4,7 +4,7 @@
 // [out_c][kernel_h][kernel_w][in_c / groups] (PyTorch's OIHW transposed), bias [out_c].
 // The epilogue is fused: out = act(conv(in) + bias) + residual.
 //
-// Conv2d packs its weights once, for one dispatch table, and picks one of three paths by
+// Conv2d packs its weights once, for one dispatch table, and picks one of five paths by
 // shape (the choice is fixed at construction):
 //   pointwise  1x1, stride 1, no padding, groups 1: the input already is the GEMM's A
 //              matrix (pixels x in_c); the table's gemm tile runs on it directly.

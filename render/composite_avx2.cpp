@@ -2,24 +2,12 @@
 // pixels at once; the samples are then read two pixels per 256-bit register: one 128-bit
 // load brings a pixel and its right neighbour (the layer is BGRA halves, 8 bytes a pixel),
 // so a bilinear footprint costs two loads and no gathers.
-//
-// The ISA flags are enabled with a target pragma after the standard headers, so no inline
-// function those headers define is compiled with AVX2 here (the linker could otherwise
-// keep that copy for the whole program).
+#include <immintrin.h>
+
+#include <cstdint>
 #include <cstring>
 
 #include "render/composite_kernels.h"
-
-#if defined(__x86_64__)
-#include <immintrin.h>
-
-// clang has no target pragma; its attribute pragma does the same for every function.
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("avx2,fma,f16c"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("avx2,fma,f16c")
-#endif
 
 namespace ampi::render::avx2 {
 namespace {
@@ -209,10 +197,3 @@ void accum_to_bgr(const float* accum, int count, uint8_t* bgr) {
 }
 
 }  // namespace ampi::render::avx2
-
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
-#endif  // __x86_64__

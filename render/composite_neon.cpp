@@ -1,12 +1,12 @@
 // NEON variant of the compositor kernels (AArch64): coordinates for 4 pixels at once,
 // then one footprint per pixel, each pixel's BGRA in one float32x4 register; a 128-bit
 // load brings a pixel and its right neighbour as 8 halves.
+#include <arm_neon.h>
+
+#include <cstdint>
 #include <cstring>
 
 #include "render/composite_kernels.h"
-
-#if defined(__aarch64__)
-#include <arm_neon.h>
 
 namespace ampi::render::neon {
 namespace {
@@ -126,4 +126,3 @@ void accum_to_bgr(const float* accum, int count, uint8_t* bgr) {
 }
 
 }  // namespace ampi::render::neon
-#endif  // __aarch64__

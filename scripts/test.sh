@@ -12,11 +12,12 @@ ctest --test-dir build --output-on-failure -j"$jobs"
 
 # aarch64: the whole program cross built with g++-aarch64-linux-gnu against an arm64
 # Debian sysroot (scripts/arm64_sysroot.sh: Debian's own arm64 packages, OpenCV included).
-# ctest runs the inference core's test binaries under qemu-aarch64 (the toolchain's
-# CMAKE_CROSSCOMPILING_EMULATOR), which makes NEON the best ISA there; qemu is about 150x
-# slower on float code, so the tests take their small shapes. Then `ampi run` itself runs
-# under qemu and must match the x86 run, and the board package is made and its installed
-# layout checked.
+# ctest runs the inference core's test binaries (engine, kernels, weights_format, nets; the
+# kernels test holds every SIMD family's NEON-against-scalar checks, the slicer's and the
+# compositor's included) under qemu-aarch64 (the toolchain's CMAKE_CROSSCOMPILING_EMULATOR),
+# which makes NEON the best ISA there; qemu is about 150x slower on float code, so the
+# tests take their small shapes. Then `ampi run` itself runs under qemu and must match the
+# x86 run, and the board package is made and its installed layout checked.
 bash scripts/arm64_sysroot.sh build-aarch64-sysroot
 cmake -S . -B build-aarch64 -DCMAKE_BUILD_TYPE=Release -DCMAKE_TOOLCHAIN_FILE=cmake/aarch64-linux-gnu.cmake \
   -DAMPI_ARM64_SYSROOT="$PWD/build-aarch64-sysroot" -DAMPI_WITH_OPENCV=ON

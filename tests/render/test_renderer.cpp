@@ -1,11 +1,11 @@
+// The tiled renderer on whole frames: against exact composites, shifts and the naive
+// warpPerspective compositor, on every ISA, tile size and thread count. Its per-row
+// kernels against the scalar reference: tests/kernels/test_composite_rows.cpp.
 #include <catch2/catch.hpp>
 #include <opencv2/imgproc.hpp>
 #include <random>
 
-#include "engine/half.h"
-#include "render/composite_kernels.h"
 #include "render/renderer.h"
-#include "support/random.h"
 #include "synthetic_mpi.h"
 
 using namespace ampi;
@@ -100,97 +100,6 @@ TEST_CASE("a fronto-parallel plane at depth z shifts by fx * t / z pixels") {
     cv::addWeighted(a, 0.5, b, 0.5, 0.0, expected);
     INFO("isa " << isa_name(isa) << ", half-pixel shift");
     CHECK(max_difference(half(cv::Rect(1, 0, source.cols - 1, source.rows)), expected) <= 1);
-  }
-}
-
-TEST_CASE("every compositor kernel matches the scalar reference") {
-  // One padded random plane, read by every variant along rows of every length around the
-  // vector widths, through random homographies (some with points behind the camera).
-  const int width = 45, height = 23;
-  const uint32_t seed = 11;
-  INFO("seed " << seed);
-  std::vector<uint16_t> padded(static_cast<size_t>(4) * (width + 3) * (height + 3), 0);
-  const auto values = test::random_floats(static_cast<size_t>(4) * width * height, seed, 0.0f, 1.0f);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x)
-      for (int k = 0; k < 4; ++k) {
-        const float alpha = values[4 * (y * width + x) + 3];
-        const float v = values[4 * (y * width + x) + k];
-        padded[4 * ((y + 1) * (width + 3) + x + 1) + k] = float_to_half(k == 3 ? alpha : v * alpha);
-      }
-  render::PlaneView plane{padded.data() + 4 * (width + 3 + 1), width + 3, width, height};
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> jitter(-1.0f, 1.0f);
-  const render::CompositeKernels reference = render::composite_kernels(Isa::Scalar);
-  for (Isa isa : runnable_isas()) {
-    const render::CompositeKernels k = render::composite_kernels(isa);
-    for (int trial = 0; trial < 40; ++trial) {
-      // Near-identity maps with scale, shear, shift and perspective; every fifth has a
-      // strong perspective term that puts part of the row behind the camera.
-      render::InverseHomography h{{1 + 0.3f * jitter(rng), 0.2f * jitter(rng), 20 * jitter(rng),
-                                   0.2f * jitter(rng), 1 + 0.3f * jitter(rng), 10 * jitter(rng),
-                                   (trial % 5 == 0 ? 0.05f : 0.002f) * jitter(rng), 0.002f * jitter(rng), 1}};
-      for (int count : {1, 2, 3, 4, 7, 8, 9, 15, 16, 17, 33, 60}) {
-        const int x_begin = trial - 20, y = trial % (height + 6) - 3;
-        INFO("isa " << isa_name(isa) << ", trial " << trial << ", count " << count);
-        const auto start = test::random_floats(4 * count, seed + trial, 0.0f, 1.0f);
-        std::vector<float> expected = start, got = start;
-        reference.warp_over_row(plane, h, y, x_begin, count, expected.data());
-        k.warp_over_row(plane, h, y, x_begin, count, got.data());
-        CHECK(test::max_abs_diff(expected.data(), got.data(), expected.size()) <= 1e-4f);
-        std::vector<uint8_t> bgr_expected(3 * count), bgr_got(3 * count, 0xAB);
-        reference.accum_to_bgr(expected.data(), count, bgr_expected.data());
-        k.accum_to_bgr(expected.data(), count, bgr_got.data());
-        CHECK(bgr_expected == bgr_got);
-      }
-    }
-  }
-}
-
-TEST_CASE("every translation kernel matches the scalar reference") {
-  // Shifts that put the row inside, across each edge and entirely outside the layer.
-  const int width = 37, height = 19;
-  const uint32_t seed = 13;
-  INFO("seed " << seed);
-  std::vector<uint16_t> padded(static_cast<size_t>(4) * (width + 3) * (height + 3), 0);
-  const auto values = test::random_floats(padded.size(), seed, 0.0f, 1.0f);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x)
-      for (int k = 0; k < 4; ++k) {
-        const size_t at = 4 * ((y + 1) * (width + 3) + x + 1) + k;
-        padded[at] = float_to_half(k == 3 ? values[at - k + 3] : values[at] * values[at - k + 3]);
-      }
-  const render::PlaneView plane{padded.data() + 4 * (width + 3 + 1), width + 3, width, height};
-  std::mt19937 rng(seed);
-  std::uniform_real_distribution<float> shift(-45.0f, 45.0f);
-  const render::CompositeKernels reference = render::composite_kernels(Isa::Scalar);
-  for (Isa isa : runnable_isas()) {
-    const render::CompositeKernels k = render::composite_kernels(isa);
-    for (int trial = 0; trial < 60; ++trial) {
-      const float du = trial < 4 ? std::vector<float>{0.0f, -1.0f, 1e9f, -1e9f}[trial] : shift(rng);
-      const float dv = trial % 7 == 0 ? std::floor(shift(rng)) : shift(rng) / 2;
-      for (int count : {1, 2, 3, 5, 8, 9, 16, 31, 64}) {
-        const int x_begin = trial % 11 - 5, y = trial % (height + 4) - 2;
-        INFO("isa " << isa_name(isa) << ", du " << du << ", dv " << dv << ", y " << y << ", x " << x_begin
-                    << ", count " << count);
-        const auto start = test::random_floats(4 * count, seed + trial, 0.0f, 1.0f);
-        std::vector<float> expected = start, got = start;
-        reference.shift_over_row(plane, du, dv, y, x_begin, count, expected.data());
-        k.shift_over_row(plane, du, dv, y, x_begin, count, got.data());
-        // The reference rounds x + du for every pixel, the kernels split du once.
-        CHECK(test::max_abs_diff(expected.data(), got.data(), expected.size()) <= 1e-4f);
-      }
-    }
-  }
-}
-
-TEST_CASE("accumulators outside [0, 1] saturate to black and white") {
-  const std::vector<float> accum = {-0.5f, 1.5f, 0.5f, 1.0f, 2.0f, -3.0f, 1.0f, 0.0f};
-  for (Isa isa : runnable_isas()) {
-    INFO("isa " << isa_name(isa));
-    std::vector<uint8_t> bgr(6);
-    render::composite_kernels(isa).accum_to_bgr(accum.data(), 2, bgr.data());
-    CHECK(bgr == std::vector<uint8_t>{0, 255, 128, 255, 0, 255});
   }
 }
 

@@ -1,4 +1,4 @@
-#include "inpaint/eval_inpaint.h"
+#include "eval/inpaint_eval.h"
 
 #include <chrono>
 #include <cmath>

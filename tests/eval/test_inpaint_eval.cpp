@@ -6,7 +6,7 @@
 
 #include <opencv2/imgproc.hpp>
 
-#include "inpaint/eval_inpaint.h"
+#include "eval/inpaint_eval.h"
 
 using namespace ampi;
 

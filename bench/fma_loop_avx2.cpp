@@ -1,0 +1,21 @@
+#include <immintrin.h>
+
+#include "bench/fma_loop.h"
+
+namespace ampi::bench::avx2 {
+
+float fma_loop(int64_t iterations, float start) {
+  __m256 acc[kFmaChains];
+  for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm256_set1_ps(start + 0.01f * j);
+  const __m256 mul = _mm256_set1_ps(kFmaMul), add = _mm256_set1_ps(kFmaAdd);
+  for (int64_t i = 0; i < iterations; ++i)
+    for (int j = 0; j < kFmaChains; ++j) acc[j] = _mm256_fmadd_ps(acc[j], mul, add);
+  for (int j = 1; j < kFmaChains; ++j) acc[0] = _mm256_add_ps(acc[0], acc[j]);
+  alignas(32) float lanes[8];
+  _mm256_store_ps(lanes, acc[0]);
+  float sum = 0.0f;  // a plain loop: no std:: template is instantiated with these flags
+  for (float lane : lanes) sum += lane;
+  return sum;
+}
+
+}  // namespace ampi::bench::avx2
