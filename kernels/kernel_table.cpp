@@ -1,33 +1,85 @@
+// The tables, built from kernels/kernel_list.def: nothing here names a kernel family.
+// Filling a table only takes the kernels' addresses, so this file is compiled for the
+// baseline target and builds every table this architecture has; kernels_for() hands out
+// only those the CPU runs.
 #include "kernels/kernel_table.h"
 
 #include <stdexcept>
 #include <string>
 
+#include "kernels/reference/reference.h"
+#if defined(AMPI_ARCH_X86)
+#include "kernels/x86/avx2_kernels.h"
+#include "kernels/x86/avx512_kernels.h"
+#endif
+#if defined(AMPI_ARCH_ARM64)
+#include "kernels/arm/neon_kernels.h"
+#endif
+
 namespace ampi {
 namespace {
 
-KernelTable build(Isa isa) {
-  KernelTable table;
-  fill_scalar_kernels(table);
-  table.isa = isa;
-  // The fill functions are compiled with their ISA's flags, so even filling the table may
-  // execute that ISA's instructions (GCC stores the pointers with AVX-512 moves): never
-  // call one the CPU cannot run. kernels_for() never hands out such a table.
-  if (!isa_runnable(isa)) return table;
-  switch (isa) {
-    case Isa::Scalar: break;
+KernelTable reference_table() {
+  KernelTable t;
+#define AMPI_KERNEL(name, ...) t.name = reference::name;
+#include "kernels/kernel_list.def"
+  return t;
+}
+
+// Each takes the variants the list's column for its ISA claims, and records them.
 #if defined(AMPI_ARCH_X86)
-    case Isa::Avx2: fill_avx2_kernels(table); break;
+void take_avx2_variants(KernelTable& t) {
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_avx2(t.name = avx2::name; t.provided_by.name = Isa::Avx2;)
+#include "kernels/kernel_list.def"
+}
+
+void take_avx512_variants(KernelTable& t) {
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_avx512(t.name = avx512::name; t.provided_by.name = Isa::Avx512;)
+#include "kernels/kernel_list.def"
+}
+#endif
+
+#if defined(AMPI_ARCH_ARM64)
+void take_neon_variants(KernelTable& t) {
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_neon(t.name = neon::name; t.provided_by.name = Isa::Neon;)
+#include "kernels/kernel_list.def"
+}
+#endif
+
+// The gemm tile is the shape the gemm kernel is written for: that of the ISA providing it.
+void set_gemm_tile(KernelTable& t) {
+  switch (t.provided_by.gemm) {
+#if defined(AMPI_ARCH_X86)
+    case Isa::Avx2: t.gemm_mr = avx2::kGemmMr, t.gemm_nr = avx2::kGemmNr; return;
+    case Isa::Avx512: t.gemm_mr = avx512::kGemmMr, t.gemm_nr = avx512::kGemmNr; return;
+#endif
+#if defined(AMPI_ARCH_ARM64)
+    case Isa::Neon: t.gemm_mr = neon::kGemmMr, t.gemm_nr = neon::kGemmNr; return;
+#endif
+    default: t.gemm_mr = reference::kGemmMr, t.gemm_nr = reference::kGemmNr; return;
+  }
+}
+
+KernelTable build(Isa isa) {
+  KernelTable table = reference_table();
+  table.isa = isa;
+  switch (isa) {
+#if defined(AMPI_ARCH_X86)
+    case Isa::Avx2: take_avx2_variants(table); break;
     case Isa::Avx512:
-      fill_avx2_kernels(table);  // AVX-512 CPUs run AVX2 code for ops without a wider variant
-      fill_avx512_kernels(table);
+      take_avx2_variants(table);  // AVX-512 CPUs run AVX2 code for ops without a wider variant
+      take_avx512_variants(table);
       break;
 #endif
 #if defined(AMPI_ARCH_ARM64)
-    case Isa::Neon: fill_neon_kernels(table); break;
+    case Isa::Neon: take_neon_variants(table); break;
 #endif
     default: break;
   }
+  set_gemm_tile(table);
   return table;
 }
 
@@ -37,14 +89,29 @@ const KernelTable& kernels_for(Isa isa) {
   if (!isa_runnable(isa))
     throw std::runtime_error(std::string("kernels for ") + isa_name(isa) +
                              " are not runnable on this CPU or build");
-  static const KernelTable tables[] = {build(Isa::Scalar), build(Isa::Avx2),
-                                       build(Isa::Avx512), build(Isa::Neon)};
+  static const KernelTable tables[] = {build(Isa::Scalar), build(Isa::Avx2), build(Isa::Avx512),
+                                       build(Isa::Neon)};
   return tables[static_cast<int>(isa)];
 }
 
 const KernelTable& kernels() {
   static const KernelTable& active = kernels_for(active_isa());
   return active;
+}
+
+const std::vector<KernelFamily>& kernel_families() {
+  static const std::vector<KernelFamily> families = {
+#define AMPI_KERNEL AMPI_KERNEL_FAMILY
+#include "kernels/kernel_list.def"
+  };
+  return families;
+}
+
+std::vector<KernelEntry> kernel_entries(const KernelTable& table) {
+  return {
+#define AMPI_KERNEL(name, ...) {#name, table.provided_by.name},
+#include "kernels/kernel_list.def"
+  };
 }
 
 }  // namespace ampi

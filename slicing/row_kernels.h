@@ -18,8 +18,10 @@
 // may differ by one level where the ratio lies within that of a half-integer.
 #pragma once
 #include <cstdint>
+#include <vector>
 
 #include "engine/isa.h"
+#include "kernels/kernel_lists.h"
 
 namespace ampi::slicing {
 
@@ -94,43 +96,52 @@ struct SnapRowInputs {
 using SnapRowFn = void (*)(const SnapRowInputs& in, int n, float min_step, float margin, float* out,
                            uint8_t* band);
 
+// Which instruction set's code each entry runs (slicing/row_kernel_list.def).
+struct SlicingProviders {
+#define AMPI_KERNEL(name, ...) Isa name = Isa::Scalar;
+#include "slicing/row_kernel_list.def"
+};
+
+// One entry per kernel of slicing/row_kernel_list.def.
 struct SlicingKernels {
   Isa isa = Isa::Scalar;
-  RangeRowFn range_row = nullptr;
-  NormalizeRowFn normalize_row = nullptr;
-  BilateralWeightsFn bilateral_weights = nullptr;
-  BilateralCombineFn bilateral_combine = nullptr;
-  SnapRowFn snap_row = nullptr;
+#define AMPI_KERNEL(name, return_type, parameters, ...) return_type(*name) parameters = nullptr;
+#include "slicing/row_kernel_list.def"
+  SlicingProviders provided_by;
 };
 
 // The variant for an instruction set; throws std::runtime_error if this build or CPU
 // cannot run it.
 SlicingKernels slicing_kernels(Isa isa);
 
-#define AMPI_SLICING_ROW_KERNELS                                                              \
-  void range_row(const float* in, int n, ValueRange& range);                                  \
-  void normalize_row(const float* in, int n, double lo, double scale, float* value,           \
-                     uint8_t* level);                                                         \
-  void bilateral_weights(const uint8_t* p, int n, const BilateralPairs& pairs, float* const* weight); \
-  void bilateral_combine(const uint8_t* center, int n, const BilateralTaps& taps, uint8_t* out); \
-  void snap_row(const SnapRowInputs& in, int n, float min_step, float margin, float* out, uint8_t* band);
+// Every kernel of slicing/row_kernel_list.def, and what `table` runs for each, in the
+// list's order.
+const std::vector<KernelFamily>& slicing_kernel_families();
+std::vector<KernelEntry> slicing_kernel_entries(const SlicingKernels& table);
 
+// The scalar reference and each ISA's variants of the kernels the list claims for it.
 namespace scalar {
-AMPI_SLICING_ROW_KERNELS
-}
-#if defined(__x86_64__)
+#define AMPI_KERNEL(name, return_type, parameters, ...) return_type name parameters;
+#include "slicing/row_kernel_list.def"
+}  // namespace scalar
+#if defined(AMPI_ARCH_X86)
 namespace avx2 {
-AMPI_SLICING_ROW_KERNELS
-}
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_avx2(return_type name parameters;)
+#include "slicing/row_kernel_list.def"
+}  // namespace avx2
 namespace avx512 {
-AMPI_SLICING_ROW_KERNELS
-}
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_avx512(return_type name parameters;)
+#include "slicing/row_kernel_list.def"
+}  // namespace avx512
 #endif
-#if defined(__aarch64__)
+#if defined(AMPI_ARCH_ARM64)
 namespace neon {
-AMPI_SLICING_ROW_KERNELS
-}
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_neon(return_type name parameters;)
+#include "slicing/row_kernel_list.def"
+}  // namespace neon
 #endif
-#undef AMPI_SLICING_ROW_KERNELS
 
 }  // namespace ampi::slicing

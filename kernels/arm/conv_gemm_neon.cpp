@@ -73,7 +73,7 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
 
 }  // namespace
 
-void gemm_8x8(const GemmArgs& g) {
+void gemm(const GemmArgs& g) {
   const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
   const float* panel = g.packed;
   for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats) {

@@ -8,25 +8,12 @@
 
 namespace ampi::avx512 {
 
-void add(const float* a, const float* b, int64_t n, ActivationSpec act, float* out);
-void activate_inplace(float* x, int64_t n, ActivationSpec act);
+// The families kernels/kernel_list.def claims for AVX-512 (contracts there).
+#define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
+  AMPI_KERNEL_IF_##in_avx512(return_type name parameters;)
+#include "kernels/kernel_list.def"
 
-// Channel operations (channels_avx512.cpp) and 2x resampling (resample_avx512.cpp); contracts
-// in kernels/kernel_table.h.
-void gated_output(const float* in, int64_t pixels, int c, ActivationSpec act, float* out);
-void concat_channels(const float* a, int ca, const float* b, int cb, int64_t pixels, float* out);
-void channel_sum(const float* in, int64_t pixels, int c, float* sum);
-void dense(const float* w, const float* bias, int rows, int cols, const float* x,
-           ActivationSpec act, float* y);
-void haar_dwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
-void haar_idwt(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
-void resize2x_nearest(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
-void resize2x_bilinear(const float* in, int h, int w, int c, int row_begin, int row_end, float* out);
-
-// Convolution micro-kernels (conv_gemm_avx512.cpp: 12x32 GEMM tile;
-// conv_depthwise_avx512.cpp); contracts in kernels/kernel_table.h.
+// The gemm tile (conv_gemm_avx512.cpp: a 12x32 tile).
 constexpr int kGemmMr = 12, kGemmNr = 32;
-void gemm_12x32(const GemmArgs& args);
-void depthwise_row(const DepthwiseRowArgs& args);
 
 }  // namespace ampi::avx512

@@ -66,7 +66,7 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
 
 }  // namespace
 
-void gemm_6x16(const GemmArgs& g) {
+void gemm(const GemmArgs& g) {
   // Into L2 (prefetcht1): the tile reads it only in the next call.
   for (int64_t i = 0; i < g.prefetch_floats; i += 16) __builtin_prefetch(g.prefetch_a + i, 0, 2);
   const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;

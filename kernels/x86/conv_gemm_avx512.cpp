@@ -111,7 +111,7 @@ void panels(const GemmArgs& g) {
 
 }  // namespace
 
-void gemm_12x32(const GemmArgs& g) {
+void gemm(const GemmArgs& g) {
   // Into L2 (prefetcht1): the tile reads it only in the next call.
   for (int64_t i = 0; i < g.prefetch_floats; i += 16) __builtin_prefetch(g.prefetch_a + i, 0, 2);
   if (!g.stream_c) return panels<false>(g);

@@ -10,7 +10,7 @@ void add(const float* a, const float* b, int64_t n, ActivationSpec act, float* o
   for (; i < n; ++i) out[i] = ampi::activate(a[i] + b[i], act);
 }
 
-void activate_inplace(float* x, int64_t n, ActivationSpec act) {
+void activate(float* x, int64_t n, ActivationSpec act) {
   int64_t i = 0;
   for (; i + 8 <= n; i += 8) _mm256_storeu_ps(x + i, activate(_mm256_loadu_ps(x + i), act));
   for (; i < n; ++i) x[i] = ampi::activate(x[i], act);

@@ -15,7 +15,7 @@ void add(const float* a, const float* b, int64_t n, ActivationSpec act, float* o
   }
 }
 
-void activate_inplace(float* x, int64_t n, ActivationSpec act) {
+void activate(float* x, int64_t n, ActivationSpec act) {
   for (int64_t i = 0; i < n; i += 16) {
     const __mmask16 m = tail_mask(n - i);
     _mm512_mask_storeu_ps(x + i, m, activate(_mm512_maskz_loadu_ps(m, x + i), act));

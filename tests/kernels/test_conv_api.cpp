@@ -1,6 +1,6 @@
 // Conv2d as the networks see it: the fused epilogue (every activation, residual), the
 // path choice, results across thread counts, weight packing, and the errors.
-#include "test_conv_util.h"
+#include "conv_cases.h"
 
 using namespace ampi;
 using namespace ampi::test;

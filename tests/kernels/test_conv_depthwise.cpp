@@ -1,6 +1,6 @@
 // Depthwise convolution (groups == in_c == out_c): the row kernels, every runnable ISA
 // against the direct reference.
-#include "test_conv_util.h"
+#include "conv_cases.h"
 
 #include "engine/tensor.h"
 

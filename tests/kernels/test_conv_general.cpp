@@ -3,7 +3,7 @@
 // path (im2col + GEMM), each chosen by shape. Every kernel size, stride, padding,
 // dilation and group count the networks use, every runnable ISA against the direct
 // reference.
-#include "test_conv_util.h"
+#include "conv_cases.h"
 
 using namespace ampi;
 using namespace ampi::test;

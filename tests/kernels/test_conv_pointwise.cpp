@@ -1,6 +1,6 @@
 // Pointwise (1x1) convolution: the packed GEMM path, every runnable ISA against the
 // direct reference.
-#include "test_conv_util.h"
+#include "conv_cases.h"
 
 #include "engine/tensor.h"
 
@@ -106,10 +106,9 @@ TEST_CASE("pointwise conv with a scaled input equals the conv of the scaled inpu
       for (Isa isa : runnable_isas()) {
         INFO(describe(c) << ", isa " << isa_name(isa));
         const Conv2d conv(c.p, d.weights.data(), d.bias.data(), kernels_for(isa));
-        std::vector<float> out(e.out.size() + kGuardFloats, kGuardValue);
-        std::fill(out.begin(), out.begin() + e.out.size(), NAN);
+        GuardedOutput out(e.out.size());
         conv.run_scaled_input(d.in.data(), c.in_h, c.in_w, scale.data(), out.data(), d.residual.data(), pool);
-        CHECK(std::all_of(out.begin() + e.out.size(), out.end(), [](float v) { return v == kGuardValue; }));
+        CHECK(out.guard_intact());
         const float err = max_abs_diff(e.out.data(), out.data(), e.out.size());
         INFO("max error " << err << ", scale " << e.scale);
         REQUIRE(err <= kRelativeTolerance * e.scale);

@@ -10,7 +10,8 @@
 using namespace ampi;
 
 TEST_CASE("add and activate with every activation: every ISA matches the reference") {
-  std::vector<int64_t> sizes = {1, 3, 4, 7, 8, 9, 15, 16, 17, 31, 33, 64, 100};
+  std::vector<int64_t> sizes;
+  for (int n : test::length_sweep()) sizes.push_back(n);
   if (!test::small_tests()) sizes.push_back(40001);  // splits over threads (grain 16384)
   for (Isa isa : runnable_isas())
     for (ThreadPool* pool : test::thread_pools())

@@ -21,11 +21,6 @@ using namespace ampi::test;
 
 namespace {
 
-template <typename T>
-std::vector<T> sweep(std::vector<T> full, std::vector<T> small) {
-  return small_tests() ? small : full;
-}
-
 struct BlockCase {
   int in_c, expanded, out_c;  // expanded == in_c: no expansion
   int kernel, dilation;

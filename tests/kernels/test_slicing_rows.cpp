@@ -1,7 +1,8 @@
 // The slicer's row kernels (slicing/row_kernels.h): every runnable ISA against the scalar
-// reference. They need no OpenCV, so they live in the core and the aarch64 build runs
-// this file under qemu for NEON. The whole filter, and the reference against OpenCV's,
-// is tested in tests/slicing/test_bilateral.cpp.
+// reference, over the harness's row lengths (kernel_sweeps.h). They need no OpenCV, so
+// they live in the core and the aarch64 build runs this file under qemu for NEON. The
+// whole filter, and the reference against OpenCV's, is tested in
+// tests/slicing/test_bilateral.cpp.
 #include <algorithm>
 #include <catch2/catch.hpp>
 #include <cmath>
@@ -12,6 +13,7 @@
 #include <vector>
 
 #include "engine/isa.h"
+#include "kernel_sweeps.h"
 #include "slicing/row_kernels.h"
 
 using namespace ampi;
@@ -24,7 +26,7 @@ TEST_CASE("every normalize_row variant equals the scalar reference bit for bit")
   for (Isa isa : runnable_isas()) {
     const slicing::SlicingKernels kernels = slicing::slicing_kernels(isa);
     for (auto [lo, hi] : ranges)
-      for (int n : {1, 3, 4, 7, 8, 9, 15, 16, 17, 31, 33, 100}) {
+      for (int n : test::length_sweep()) {
         std::vector<float> in(n);
         for (float& v : in) v = lo + unit(rng) * (hi - lo);
         in[0] = lo;
@@ -50,7 +52,7 @@ TEST_CASE("every range_row variant finds the scalar range and every non-finite v
                        -std::numeric_limits<float>::infinity()};
   for (Isa isa : runnable_isas()) {
     const slicing::RangeRowFn range_row = slicing::slicing_kernels(isa).range_row;
-    for (int n : {1, 3, 4, 7, 8, 9, 15, 16, 17, 31, 33, 100}) {
+    for (int n : test::length_sweep()) {
       std::vector<float> in(n);
       for (float& v : in) v = value(rng);
       slicing::ValueRange want{in[0], in[0], true}, got = want;
@@ -111,7 +113,7 @@ TEST_CASE("every bilateral weights variant matches the reference's tables") {
   for (Isa isa : runnable_isas()) {
     const slicing::SlicingKernels kernels = slicing::slicing_kernels(isa);
     for (int r : {1, 2, 4})
-      for (int w : {1, 2, 7, 8, 9, 15, 16, 17, 33}) {
+      for (int w : test::length_sweep()) {
         const PairSetup s(r, w, 20.0, 3.0, static_cast<uint32_t>(r * 100 + w));
         const int n = w + 2 * r;
         std::vector<std::vector<float>> want(s.pairs.count, std::vector<float>(n)), got = want;
@@ -134,7 +136,7 @@ TEST_CASE("every bilateral combine variant matches the reference within one leve
     const slicing::SlicingKernels kernels = slicing::slicing_kernels(isa);
     long long pixels = 0, differing = 0;
     for (int r : {1, 2, 4})
-      for (int w : {1, 2, 7, 8, 9, 15, 16, 17, 33, 100}) {
+      for (int w : test::length_sweep()) {
         const PairSetup s(r, w, 20.0, 3.0, static_cast<uint32_t>(r * 1000 + w));
         // The taps of the centre row: the centre (weight 1) and each pair's forward tap,
         // weighed with the reference's weights, so only the sums can differ.
@@ -172,7 +174,7 @@ TEST_CASE("every snap_row variant equals the scalar reference bit for bit") {
   std::uniform_real_distribution<float> unit(0.0f, 1.0f), colour(0.0f, 255.0f), coeff(-0.02f, 0.02f);
   for (Isa isa : runnable_isas()) {
     const slicing::SnapRowFn snap_row = slicing::slicing_kernels(isa).snap_row;
-    for (int n : {1, 3, 4, 5, 7, 8, 9, 15, 16, 17, 31, 33, 100})
+    for (int n : test::length_sweep())
       for (float margin : {0.0f, 0.1f}) {
         std::vector<float> lo(n), hi(n), d(n), blue(n), green(n), red(n), a0(n), a1(n), a2(n), b(n);
         for (int x = 0; x < n; ++x) {

@@ -1,41 +1,20 @@
-// Helpers shared by the convolution tests: one random layer per seed, the comparison of
-// Conv2d (any table, any pool) with the naive direct reference, and the small mode.
+// The convolution cases of the kernel tests, on the sweep harness (kernel_sweeps.h):
+// one random layer per seed, and the comparison of Conv2d (any table, any pool) with the
+// naive direct reference.
 #pragma once
 #include <catch2/catch.hpp>
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
-#include <cstring>
 #include <sstream>
 #include <string>
 #include <vector>
 
+#include "kernel_sweeps.h"
 #include "kernels/conv.h"
 #include "kernels/reference/conv_reference.h"
-#include "support/random.h"
 
 namespace ampi::test {
-
-// AMPI_TEST_SMALL=1 trims the sweeps to what runs in seconds under qemu (~150x slower).
-inline bool small_mode() {
-  const char* v = std::getenv("AMPI_TEST_SMALL");
-  return v && *v && std::strcmp(v, "0") != 0;
-}
-
-// Picks the full or the small list.
-template <typename T>
-std::vector<T> sweep(std::vector<T> full, std::vector<T> small) {
-  return small_mode() ? small : full;
-}
-
-inline const std::vector<ActivationSpec>& all_activations() {
-  static const std::vector<ActivationSpec> list = {
-      {Activation::None},      {Activation::ReLU},      {Activation::ReLU6},
-      {Activation::HardSwish}, {Activation::HardSigmoid}, {Activation::Sigmoid},
-      {Activation::LeakyReLU, 0.1f}, {Activation::ELU, 1.0f}, {Activation::Tanh}};
-  return list;
-}
 
 struct ConvCase {
   ConvParams p;
@@ -70,16 +49,8 @@ struct ConvData {
   const float* residual_or_null() const { return residual.empty() ? nullptr : residual.data(); }
 };
 
-inline float max_abs(const std::vector<float>& v) {
-  float m = 0.0f;
-  for (float x : v) m = std::max(m, std::fabs(x));
-  return m;
-}
-
-// Expected output and the error scale of a case: the reference convolution before the
-// epilogue, then the epilogue. Error is judged relative to the magnitude of the values
-// the kernels sum (pre-activation plus residual): an activation can shrink the output
-// (sigmoid of a large sum) but not the rounding error of the sum before it.
+// Expected output and the error scale of a case (kRelativeTolerance): the reference
+// convolution before the epilogue, then the epilogue.
 struct Expected {
   std::vector<float> out;
   float scale = 0.0f;
@@ -98,26 +69,14 @@ inline Expected expected_output(const ConvCase& c, const ConvData& d) {
   return e;
 }
 
-constexpr float kRelativeTolerance = 1e-5f;
-
-// Floats past the end of the output that must stay untouched (a full AVX-512 vector and
-// more): catches tail stores that spill over.
-constexpr size_t kGuardFloats = 64;
-constexpr float kGuardValue = 12345.0f;
-
-// Runs Conv2d; the output starts as NaN so an unwritten value cannot pass.
+// Runs Conv2d into a GuardedOutput: a value never written or one written past the end fails.
 inline std::vector<float> run_conv(const ConvCase& c, const ConvData& d, const KernelTable& k,
                                    ThreadPool& pool) {
   const Conv2d conv(c.p, d.weights.data(), d.bias.data(), k);
-  const size_t size = static_cast<size_t>(c.p.out_h(c.in_h)) * c.p.out_w(c.in_w) * c.p.out_c;
-  std::vector<float> out(size + kGuardFloats, kGuardValue);
-  std::fill(out.begin(), out.begin() + size, NAN);
+  GuardedOutput out(static_cast<size_t>(c.p.out_h(c.in_h)) * c.p.out_w(c.in_w) * c.p.out_c);
   conv.run(d.in.data(), c.in_h, c.in_w, out.data(), d.residual_or_null(), pool);
-  const bool guard_intact =
-      std::all_of(out.begin() + size, out.end(), [](float v) { return v == kGuardValue; });
-  CHECK(guard_intact);
-  out.resize(size);
-  return out;
+  CHECK(out.guard_intact());
+  return out.values();
 }
 
 // Conv2d on every runnable table (the pool's thread count) against the reference.
