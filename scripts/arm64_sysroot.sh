@@ -11,24 +11,23 @@ dir=${1:-build-aarch64-sysroot}
 mirror=${AMPI_DEBIAN_MIRROR:-http://deb.debian.org/debian}
 [ -f "$dir/.ampi-sysroot-complete" ] && exit 0
 
-if ! command -v debootstrap >/dev/null; then
-  SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
-  $SUDO apt-get update -q
-  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -q --no-install-recommends debootstrap
-fi
+command -v debootstrap >/dev/null || [ -x /usr/sbin/debootstrap ] ||
+  { echo "arm64_sysroot.sh: needs debootstrap (bash scripts/setup.sh)" >&2; exit 1; }
+# debootstrap makes device nodes and owners in the tree: root's work
+SUDO=""; [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 
-rm -rf "$dir"
-mkdir -p "$dir"
+$SUDO rm -rf "$dir"
+$SUDO mkdir -p "$dir"
 echo "arm64 sysroot: downloading Debian 12 arm64 packages into $dir"
 log=$(mktemp)
-debootstrap --arch=arm64 --foreign --variant=minbase --include=libopencv-dev,libstdc++-12-dev \
-  bookworm "$dir" "$mirror" >"$log" 2>&1 || { tail -20 "$log"; exit 1; }
+$SUDO env PATH="$PATH:/usr/sbin:/sbin" debootstrap --arch=arm64 --foreign --variant=minbase \
+  --include=libopencv-dev,libstdc++-12-dev bookworm "$dir" "$mirror" >"$log" 2>&1 || { tail -20 "$log"; exit 1; }
 rm -f "$log"
-for deb in "$dir"/var/cache/apt/archives/*.deb; do dpkg -x "$deb" "$dir"; done
+for deb in "$dir"/var/cache/apt/archives/*.deb; do $SUDO dpkg -x "$deb" "$dir"; done
 # libopencv-core links against libblas.so.3 and liblapack.so.3, which Debian provides
 # through the alternatives system (dpkg never ran here).
 lib="$dir/usr/lib/aarch64-linux-gnu"
-ln -sf blas/libblas.so.3 "$lib/libblas.so.3"
-ln -sf lapack/liblapack.so.3 "$lib/liblapack.so.3"
-touch "$dir/.ampi-sysroot-complete"
+$SUDO ln -sf blas/libblas.so.3 "$lib/libblas.so.3"
+$SUDO ln -sf lapack/liblapack.so.3 "$lib/liblapack.so.3"
+$SUDO touch "$dir/.ampi-sysroot-complete"
 echo "arm64 sysroot: $dir ($(du -sh "$dir" | cut -f1))"

@@ -31,7 +31,6 @@ from __future__ import annotations
 import argparse
 import hashlib
 import inspect
-import subprocess
 import sys
 from pathlib import Path
 
@@ -43,6 +42,7 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "weights_format"))
 import depth_anything as dav2  # noqa: E402
 from ampw import AmpwError, read_ampw, write_ampw  # noqa: E402
+from export_depth import git_commit  # noqa: E402
 
 ARCH_NAME = "ampi.depth.dav2-vit-dpt"
 FORMAT_VERSION = 1
@@ -239,14 +239,6 @@ def ampw_contents(state: dict, cfg: dav2.Config, variant: str, provenance: dict,
     meta["depth.parameters"] = int(sum(a.size for a in tensors.values()))
     meta.update(provenance)
     return tensors, meta
-
-
-def git_commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "HEAD"], cwd=HERE, capture_output=True, text=True,
-                              check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def source_provenance(path: str, variant: str) -> dict:
