@@ -8,8 +8,8 @@
 #include <string>
 #include <vector>
 
-#include "engine/cpu_caches.h"
 #include "engine/tensor.h"
+#include "kernels/output_streaming.h"
 
 namespace ampi {
 namespace {
@@ -18,8 +18,6 @@ namespace {
 // per-tile loop while the scratch (tile pixels x kernel_h*kernel_w*in_c/groups floats:
 // 48 x 1152 floats = 216 KiB for a 3x3 conv over 128 channels on AVX2) stays in L2.
 constexpr int kGemmTilesPerIm2colTile = 8;
-// Pointwise path: gemm tiles per parallel_for grain, enough to amortise the scheduling.
-constexpr int64_t kPointwiseGrainTiles = 4;
 // Taps path: convolutions with at most this many outputs (one NEON vector).
 constexpr int kTapsMaxOutputs = 4;
 // Taps path: row bands per thread, so uneven bands even out; each band computes the
@@ -32,23 +30,6 @@ constexpr int kTapsMinBandSeams = 4;
 // (kernel_w * in_c, or in_c when the taps are dilated across the row); shorter runs would
 // spend more on reloading the output tile between calls than im2col's copies cost.
 constexpr int kRowsMinRun = 16;
-
-// Outputs (depthwise and pointwise) larger than this many last-level caches go out with
-// streaming stores (DepthwiseRowArgs::stream_out, GemmArgs::stream_c). Outputs that may
-// still be cached when the next layer reads them keep plain stores: streaming a 12 MB
-// output (3x3 s2 over 512x384x64) measured 10% slower than plain stores with a 32 MB L3.
-constexpr size_t kStreamOutputCaches = 1;
-// When the system does not say (no sysfs cache description, e.g. under qemu).
-constexpr size_t kDefaultLastLevelCacheBytes = size_t{32} << 20;
-
-// Whether an output of `floats` at `out` with c channels (c floats apart, pixel after
-// pixel) can and should be stored with streaming stores (DepthwiseRowArgs::stream_out,
-// GemmArgs::stream_c).
-bool stream_output(const float* out, int64_t floats, int c) {
-  const bool whole_lines = reinterpret_cast<uintptr_t>(out) % 64 == 0 && c % 16 == 0;
-  const size_t bytes = static_cast<size_t>(floats) * sizeof(float);
-  return whole_lines && bytes > kStreamOutputCaches * cache_bytes(0, kDefaultLastLevelCacheBytes);
-}
 
 [[noreturn]] void fail(const std::string& what) { throw std::runtime_error("conv: " + what); }
 
@@ -218,20 +199,6 @@ void validate(const ConvParams& p) {
     fail("groups " + std::to_string(p.groups) + " does not divide out_c " + std::to_string(p.out_c));
 }
 
-int64_t gemm_packed_size(int n, int k, int nr) {
-  const int64_t panels = (n + nr - 1) / nr;
-  return panels * (1 + static_cast<int64_t>(k)) * nr;
-}
-
-void pack_gemm_weights(const float* b, const float* bias, int n, int k, int nr, float* packed) {
-  for (int j0 = 0; j0 < n; j0 += nr) {
-    for (int j = 0; j < nr; ++j) *packed++ = (j0 + j < n && bias) ? bias[j0 + j] : 0.0f;
-    for (int kk = 0; kk < k; ++kk)
-      for (int j = 0; j < nr; ++j)
-        *packed++ = j0 + j < n ? b[static_cast<int64_t>(j0 + j) * k + kk] : 0.0f;
-  }
-}
-
 Conv2d::Conv2d(const ConvParams& p, const float* weights, const float* bias, const KernelTable& k)
     : p_(p), path_(Path::General), k_(&k) {
   validate(p);
@@ -367,26 +334,17 @@ DepthwiseRowArgs Conv2d::depthwise_row_args(int in_w, int out_w, int pad_left) c
 
 void Conv2d::run_pointwise(const float* packed, const float* in, int64_t pixels, float* out,
                            const float* residual, ThreadPool& pool) const {
-  const int mr = k_->gemm_mr;
-  GemmArgs base = pointwise_gemm_args();
-  base.packed = packed;
-  base.stream_c = stream_output(out, pixels * p_.out_c, p_.out_c);
-  const int64_t tiles = (pixels + mr - 1) / mr;
-  pool.parallel_for(tiles, kPointwiseGrainTiles, [&](int64_t first, int64_t last) {
-    GemmArgs g = base;
-    for (int64_t t = first; t < last; ++t) {
-      const int64_t row = t * mr;
-      g.m = static_cast<int>(std::min<int64_t>(mr, pixels - row));
-      g.a = in + row * p_.in_c;
-      g.c = out + row * p_.out_c;
-      g.residual = residual ? residual + row * p_.out_c : nullptr;
-      // The next tile's rows follow this one's in the input.
-      const int64_t next_rows = std::min<int64_t>(mr, std::max<int64_t>(0, pixels - row - mr));
-      g.prefetch_a = next_rows > 0 ? g.a + static_cast<int64_t>(mr) * p_.in_c : nullptr;
-      g.prefetch_floats = next_rows * p_.in_c;
-      k_->gemm(g);
-    }
-  });
+  GemmProblem g;
+  g.m = static_cast<int>(pixels);
+  g.n = p_.out_c;
+  g.k = p_.in_c;
+  g.a = in;
+  g.a_stride = p_.in_c;
+  g.c = out;
+  g.c_stride = p_.out_c;
+  g.residual = residual;
+  g.act = p_.act;
+  gemm_packed(g, packed, pool, *k_);
 }
 
 void Conv2d::run_depthwise(const float* in, int in_h, int in_w, float* out, const float* residual,

@@ -7,7 +7,8 @@
 // Conv2d packs its weights once, for one dispatch table, and picks one of five paths by
 // shape (the choice is fixed at construction):
 //   pointwise  1x1, stride 1, no padding, groups 1: the input already is the GEMM's A
-//              matrix (pixels x in_c); the table's gemm tile runs on it directly.
+//              matrix (pixels x in_c); the GEMM op (kernels/gemm.h) runs on it directly
+//              with the packed filters.
 //   depthwise  groups == in_c == out_c: the table's depthwise_row kernel, one output row
 //              per call, vectorised across channels.
 //   taps       a k x k convolution with at most 4 outputs, stride 1, groups 1 (a head
@@ -31,6 +32,7 @@
 #include <memory>
 
 #include "engine/thread_pool.h"
+#include "kernels/gemm.h"
 #include "kernels/kernel_table.h"
 
 namespace ampi {
@@ -53,13 +55,6 @@ struct ConvParams {
 // Throws std::runtime_error naming the first invalid field ("conv: groups 3 does not
 // divide in_c 16").
 void validate(const ConvParams& p);
-
-// Packs GEMM weights for a table whose tile is nr columns wide: b is [n][k] row-major
-// (n output channels of k weights: one OHWI filter per row), bias [n] or nullptr.
-// Writes ceil(n / nr) panels of (1 + k) * nr floats: the panel's bias, then for each kk
-// the nr weights b[j][kk]; columns past n are zero. Returns the floats written.
-int64_t gemm_packed_size(int n, int k, int nr);
-void pack_gemm_weights(const float* b, const float* bias, int n, int k, int nr, float* packed);
 
 class Conv2d {
  public:

@@ -8,8 +8,6 @@
 // every other to the scalar reference, which every family has). A reader defines
 // AMPI_KERNEL, includes the list, and the list undefines it.
 #pragma once
-#include <vector>
-
 #include "engine/isa.h"
 
 // AMPI_KERNEL_IF_##column(...) keeps its arguments where the column says yes and drops
@@ -19,8 +17,9 @@
 // A list line as a KernelFamily initialiser (with a comma): for kernel_families().
 #define AMPI_KERNEL_CLAIM_yes true
 #define AMPI_KERNEL_CLAIM_no false
-#define AMPI_KERNEL_FAMILY(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  ::ampi::KernelFamily{#name, AMPI_KERNEL_CLAIM_##in_avx2, AMPI_KERNEL_CLAIM_##in_avx512, AMPI_KERNEL_CLAIM_##in_neon},
+#define AMPI_KERNEL_FAMILY(name, return_type, parameters, in_avx2, in_avx512, in_neon)              \
+  ::ampi::KernelFamily{#name, AMPI_KERNEL_CLAIM_##in_avx2, AMPI_KERNEL_CLAIM_##in_avx512,                \
+                       AMPI_KERNEL_CLAIM_##in_neon},
 
 namespace ampi {
 

@@ -19,7 +19,7 @@ namespace ampi {
 
 // ---- arguments of the gemm and depthwise_row kernels ----------------------------------
 // One GEMM tile: C[i][j] = act(bias[j] + sum_kk A[i][kk] * B[kk][j]) (+ R[i][j]) for
-// i < m, j < n. B and bias come packed (kernels/conv.h, pack_gemm_weights): ceil(n / nr)
+// i < m, j < n. B and bias come packed (kernels/gemm.h, pack_gemm_panels): ceil(n / nr)
 // panels of nr columns, each [bias: nr][k][nr], zero padded past n.
 struct GemmArgs {
   int m = 0, n = 0, k = 0;          // rows (1..gemm_mr), output columns, reduction length

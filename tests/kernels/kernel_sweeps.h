@@ -3,7 +3,7 @@
 // NEON, 8 for AVX2, 16 for AVX-512) and panel width, odd lengths and sizes, thread counts,
 // every activation, every runnable ISA, fixed seeds (support/random.h) printed on failure.
 // AMPI_TEST_SMALL=1 picks a subset that runs in seconds under qemu (about 150x slower on
-// float code). The convolution cases (conv_cases.h) build on it.
+// float code). The convolution cases (conv_cases.h) and the GEMM test build on it.
 #pragma once
 #include <algorithm>
 #include <cmath>
