@@ -26,9 +26,9 @@ double time_ms(F&& f) {
   return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
-// ampi bench kernels [--threads N] [--runs N] [--clock wall|cpu] [--out FILE]: convolution
-// kernels of every runnable ISA against the machine's FMA peak and memory bandwidth
-// (kernels_bench.cpp).
+// ampi bench kernels [--threads N] [--runs N] [--clock wall|cpu] [--out FILE]: every
+// kernel family of every runnable ISA, the convolutions and the GEMM op included, against
+// the machine's FMA peak and memory bandwidth (kernels_bench.cpp).
 int kernels_benchmark(int argc, char** argv);
 
 // ampi bench render [--frames N] [--naive-frames N] [--size WxH] [--planes N] [--out FILE]:

@@ -1,6 +1,7 @@
 #include "bench/network_bench.h"
 
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -12,6 +13,7 @@
 #include "engine/thread_pool.h"
 #include "nets/bundled_weights.h"
 #include "nets/model_loader.h"
+#include "pipeline/progress.h"
 #include "weights_format/npy.h"
 
 namespace ampi::bench {
@@ -43,11 +45,27 @@ std::string json_line(const std::string& variant, int threads, const std::vector
   return line.str();
 }
 
+// Loads the model, and tells on stderr how much the load raised the resident peak beside
+// the file's size and the float weights' (loading reads the file once and packs its
+// weights for the kernels, so the peak should stay within the two together).
+std::unique_ptr<DepthModel> load_and_measure(const std::string& path) {
+  const bool windowed = reset_peak_rss();
+  const double before_mb = peak_rss_mb();
+  std::unique_ptr<DepthModel> net = load_depth_model(path);
+  if (windowed && before_mb > 0) {
+    const double file_mb = static_cast<double>(std::filesystem::file_size(path)) / 1e6;
+    const double weights_mb = static_cast<double>(net->parameter_count()) * sizeof(float) / 1e6;
+    std::fprintf(stderr, "ampi: loading %s raised the resident peak by %.1f MB (file %.1f MB, weights %.1f MB)\n",
+                 path.c_str(), peak_rss_mb() - before_mb, file_mb, weights_mb);
+  }
+  return net;
+}
+
 }  // namespace
 
 int network_benchmark(const NetworkBenchOptions& o) {
   const Tensor rgb = read_rgb(o.input);
-  const std::unique_ptr<DepthModel> net = load_depth_model(depth_weights_path(o.weights, o.model));
+  const std::unique_ptr<DepthModel> net = load_and_measure(depth_weights_path(o.weights, o.model));
   for (int threads : o.threads) {
     ThreadPool pool(threads);
     Tensor output;

@@ -19,6 +19,7 @@ struct NetworkBenchOptions {
 
 // Prints one JSON line per thread count (what bench/peers/run_peers.py reads):
 //   {"engine": "ampi", "model": ..., "isa": ..., "threads": T, "ms": [...]}
+// and on stderr how much loading raised the resident peak, beside the file's size.
 // Throws std::runtime_error for a missing input or an unreadable file.
 int network_benchmark(const NetworkBenchOptions& options);
 

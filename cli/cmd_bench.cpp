@@ -91,7 +91,7 @@ struct Benchmark {
 };
 
 const Benchmark kBenchmarks[] = {
-    {"kernels", bench::kernels_benchmark, "convolution kernels vs the machine's FMA peak and memory bandwidth"},
+    {"kernels", bench::kernels_benchmark, "every kernel family vs the machine's FMA peak and memory bandwidth"},
     {"render", bench::render_benchmark, "MPI renderer frames/s vs the naive compositor (1024x768, 8 planes)"},
     {"pipeline", bench_pipeline, "ampi run stage by stage, peak memory (1024x768 and 4K)"},
     {"network", bench_network, "the depth network alone on an .npy image (bench/peers/run.sh: vs its peers)"},

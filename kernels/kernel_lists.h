@@ -8,12 +8,18 @@
 // every other to the scalar reference, which every family has). A reader defines
 // AMPI_KERNEL, includes the list, and the list undefines it.
 #pragma once
+#include <vector>
+
 #include "engine/isa.h"
 
 // AMPI_KERNEL_IF_##column(...) keeps its arguments where the column says yes and drops
 // them where it says no.
 #define AMPI_KERNEL_IF_yes(...) __VA_ARGS__
 #define AMPI_KERNEL_IF_no(...)
+// A list line's registration for one ISA: where `column` says yes, table.name takes
+// ns::name and records `isa` as its provider (kernel_table.cpp, slicing/row_kernels.cpp).
+#define AMPI_KERNEL_TAKE(table, ns, isa, column, name) \
+  AMPI_KERNEL_IF_##column(table.name = ns::name; table.provided_by.name = isa;)
 // A list line as a KernelFamily initialiser (with a comma): for kernel_families().
 #define AMPI_KERNEL_CLAIM_yes true
 #define AMPI_KERNEL_CLAIM_no false
@@ -39,12 +45,22 @@ struct KernelFamily {
   }
 };
 
-// The ISA whose code a table for `isa` runs for a family: its own variant, AVX2's for an
-// AVX-512 table where only AVX2 has one, else the scalar reference.
+// The ISAs whose variants a table for `isa` takes over the scalar reference, in order,
+// each overwriting the one before: AVX-512 CPUs run AVX2 code, so an AVX-512 table
+// starts from AVX2's variants. Every table of both lists is built in this order.
+inline std::vector<Isa> variant_sources(Isa isa) {
+  if (isa == Isa::Avx512) return {Isa::Avx2, Isa::Avx512};
+  if (isa == Isa::Scalar) return {};
+  return {isa};
+}
+
+// The ISA whose code a table for `isa` runs for a family: the last of its variant
+// sources that has a variant, else the scalar reference.
 inline Isa kernel_provider(const KernelFamily& f, Isa isa) {
-  if (f.has_variant(isa)) return isa;
-  if (isa == Isa::Avx512 && f.avx2) return Isa::Avx2;
-  return Isa::Scalar;
+  Isa provider = Isa::Scalar;
+  for (Isa source : variant_sources(isa))
+    if (f.has_variant(source)) provider = source;
+  return provider;
 }
 
 // What a table runs for one family, for code that walks every entry (tests, benchmarks).

@@ -26,28 +26,31 @@ KernelTable reference_table() {
   return t;
 }
 
-// Each takes the variants the list's column for its ISA claims, and records them.
+// Takes the variants the list's column for `source` claims, and records them.
+void take_variants(KernelTable& t, Isa source) {
+  switch (source) {
 #if defined(AMPI_ARCH_X86)
-void take_avx2_variants(KernelTable& t) {
+    case Isa::Avx2:
 #define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  AMPI_KERNEL_IF_##in_avx2(t.name = avx2::name; t.provided_by.name = Isa::Avx2;)
+  AMPI_KERNEL_TAKE(t, avx2, Isa::Avx2, in_avx2, name)
 #include "kernels/kernel_list.def"
-}
-
-void take_avx512_variants(KernelTable& t) {
+      break;
+    case Isa::Avx512:
 #define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  AMPI_KERNEL_IF_##in_avx512(t.name = avx512::name; t.provided_by.name = Isa::Avx512;)
+  AMPI_KERNEL_TAKE(t, avx512, Isa::Avx512, in_avx512, name)
 #include "kernels/kernel_list.def"
-}
+      break;
 #endif
-
 #if defined(AMPI_ARCH_ARM64)
-void take_neon_variants(KernelTable& t) {
+    case Isa::Neon:
 #define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  AMPI_KERNEL_IF_##in_neon(t.name = neon::name; t.provided_by.name = Isa::Neon;)
+  AMPI_KERNEL_TAKE(t, neon, Isa::Neon, in_neon, name)
 #include "kernels/kernel_list.def"
-}
+      break;
 #endif
+    default: break;
+  }
+}
 
 // The gemm tile is the shape the gemm kernel is written for: that of the ISA providing it.
 void set_gemm_tile(KernelTable& t) {
@@ -66,19 +69,7 @@ void set_gemm_tile(KernelTable& t) {
 KernelTable build(Isa isa) {
   KernelTable table = reference_table();
   table.isa = isa;
-  switch (isa) {
-#if defined(AMPI_ARCH_X86)
-    case Isa::Avx2: take_avx2_variants(table); break;
-    case Isa::Avx512:
-      take_avx2_variants(table);  // AVX-512 CPUs run AVX2 code for ops without a wider variant
-      take_avx512_variants(table);
-      break;
-#endif
-#if defined(AMPI_ARCH_ARM64)
-    case Isa::Neon: take_neon_variants(table); break;
-#endif
-    default: break;
-  }
+  for (Isa source : variant_sources(isa)) take_variants(table, source);
   set_gemm_tile(table);
   return table;
 }

@@ -15,27 +15,31 @@ SlicingKernels reference_table() {
   return t;
 }
 
+// Takes the variants the list's column for `source` claims, and records them.
+void take_variants(SlicingKernels& t, Isa source) {
+  switch (source) {
 #if defined(AMPI_ARCH_X86)
-void take_avx2_variants(SlicingKernels& t) {
+    case Isa::Avx2:
 #define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  AMPI_KERNEL_IF_##in_avx2(t.name = avx2::name; t.provided_by.name = Isa::Avx2;)
+  AMPI_KERNEL_TAKE(t, avx2, Isa::Avx2, in_avx2, name)
 #include "slicing/row_kernel_list.def"
-}
-
-void take_avx512_variants(SlicingKernels& t) {
+      break;
+    case Isa::Avx512:
 #define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  AMPI_KERNEL_IF_##in_avx512(t.name = avx512::name; t.provided_by.name = Isa::Avx512;)
+  AMPI_KERNEL_TAKE(t, avx512, Isa::Avx512, in_avx512, name)
 #include "slicing/row_kernel_list.def"
-}
+      break;
 #endif
-
 #if defined(AMPI_ARCH_ARM64)
-void take_neon_variants(SlicingKernels& t) {
+    case Isa::Neon:
 #define AMPI_KERNEL(name, return_type, parameters, in_avx2, in_avx512, in_neon) \
-  AMPI_KERNEL_IF_##in_neon(t.name = neon::name; t.provided_by.name = Isa::Neon;)
+  AMPI_KERNEL_TAKE(t, neon, Isa::Neon, in_neon, name)
 #include "slicing/row_kernel_list.def"
-}
+      break;
 #endif
+    default: break;
+  }
+}
 
 }  // namespace
 
@@ -45,19 +49,7 @@ SlicingKernels slicing_kernels(Isa isa) {
                              " are not runnable on this CPU or build");
   SlicingKernels table = reference_table();
   table.isa = isa;
-  switch (isa) {
-#if defined(AMPI_ARCH_X86)
-    case Isa::Avx2: take_avx2_variants(table); break;
-    case Isa::Avx512:
-      take_avx2_variants(table);  // as the core tables: AVX2's where AVX-512 has none
-      take_avx512_variants(table);
-      break;
-#endif
-#if defined(AMPI_ARCH_ARM64)
-    case Isa::Neon: take_neon_variants(table); break;
-#endif
-    default: break;
-  }
+  for (Isa source : variant_sources(isa)) take_variants(table, source);
   return table;
 }
 
