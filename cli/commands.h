@@ -11,5 +11,6 @@ int cmd_slice(int argc, char** argv);
 int cmd_depth(int argc, char** argv);
 int cmd_render(int argc, char** argv);
 int cmd_eval(int argc, char** argv);
+int cmd_distill(int argc, char** argv);
 
 }  // namespace ampi::cli

@@ -25,6 +25,7 @@ const Command kCommands[] = {
     {"depth", ampi::cli::cmd_depth, "estimate a photo's disparity, write a 16-bit PNG"},
     {"render", ampi::cli::cmd_render, "new views of a saved MPI: frame, video, GIF, stereo, viewer"},
     {"eval", ampi::cli::cmd_eval, "reproduce the paper's evaluations on a folder of photos"},
+    {"distill", ampi::cli::cmd_distill, "label a folder of photos with a teacher's 10x ensemble"},
 };
 
 void print_usage(FILE* out) {

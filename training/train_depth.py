@@ -15,6 +15,8 @@ Data sources (--data), all yielding (rgb, disparity) pairs, rgb in [0, 1]:
   cards        the small built-in generator of training/card_scenes.py (exact disparity)
   pairs:DIR    a folder of photos NAME.jpg|png with disparity maps NAME.npy beside them
                (what training/distill.py writes for pseudo-labelled photos)
+  distilled:LABELS  a label folder of `ampi distill` (16-bit PNGs, labels.tsv naming each
+               label's photo); the ordinal set's validation photos are left out
 Validation uses a disjoint fixed set: scene seeds from VAL_SEED_START, or every tenth
 pair by sorted name (never trained on).
 
@@ -96,23 +98,48 @@ class CardSource:
 
 
 class PairFolderSource:
-    """Photos with disparity maps beside them (NAME.npy), resized to the training size.
-    Every tenth pair by sorted name is the validation split."""
+    """Photos with disparity maps, resized to the training size. Every tenth pair by
+    sorted name is the validation split."""
 
-    def __init__(self, folder: str, size):
+    def __init__(self, pairs, size, where: str):
         self.width, self.height = size
-        images = sorted(p for p in Path(folder).iterdir() if p.suffix.lower() in (".jpg", ".jpeg", ".png"))
-        pairs = [(p, p.with_suffix(".npy")) for p in images if p.with_suffix(".npy").exists()]
         if not pairs:
-            raise FileNotFoundError(f"{folder}: no image with a NAME.npy disparity beside it")
+            raise FileNotFoundError(f"{where}: no photo with a disparity map")
+        pairs = sorted(pairs)
         self.val = pairs[::VAL_EVERY_TENTH]
         self.train = [p for i, p in enumerate(pairs) if i % VAL_EVERY_TENTH]
 
+    @classmethod
+    def from_folder(cls, folder: str, size):
+        """Photos NAME.jpg|png with NAME.npy beside them (training/distill.py's output)."""
+        images = [p for p in Path(folder).iterdir() if p.suffix.lower() in (".jpg", ".jpeg", ".png")]
+        pairs = [(p, p.with_suffix(".npy")) for p in images if p.with_suffix(".npy").exists()]
+        return cls(pairs, size, folder)
+
+    @classmethod
+    def from_labels(cls, folder: str, size, held_out: set):
+        """An `ampi distill` label folder; photos in `held_out` (resolved paths) are left out."""
+        lines = (Path(folder) / "labels.tsv").read_text().splitlines()
+        if not lines or lines[0] != "ampi-distill\t1":
+            raise ValueError(f"{folder}/labels.tsv: not a label folder of ampi distill")
+        header = dict(line.split("\t", 1) for line in lines[1:4])
+        images = Path(header["images"])
+        pairs = []
+        for line in lines[4:]:
+            label, photo = line.split("\t")
+            if (images / photo).resolve() not in held_out:
+                pairs.append((images / photo, Path(folder) / label))
+        return cls(pairs, size, folder)
+
     def _load(self, pair):
-        from PIL import Image  # Debian's python3-pil
-        image = Image.open(pair[0])
-        image = np.asarray(image.convert("RGB").resize((self.width, self.height), Image.BILINEAR))
-        rgb, disparity = to_tensors(image, np.load(pair[1]).astype(np.float32))
+        from PIL import Image, ImageOps  # Debian's python3-pil
+        image = ImageOps.exif_transpose(Image.open(pair[0])).convert("RGB")
+        disparity = read_disparity(pair[1])
+        if disparity.shape != (image.height, image.width):
+            raise ValueError(f"{pair[1]}: {disparity.shape[1]}x{disparity.shape[0]}, "
+                             f"its photo {pair[0]} is {image.width}x{image.height}")
+        image = np.asarray(image.resize((self.width, self.height), Image.BILINEAR))
+        rgb, disparity = to_tensors(image, disparity)
         disparity = F.interpolate(disparity[None], size=(self.height, self.width), mode="bilinear",
                                   align_corners=False)[0]
         return rgb, disparity
@@ -125,14 +152,25 @@ class PairFolderSource:
         return min(wanted, len(self.val))
 
 
-def make_source(spec: str, size):
+def read_disparity(path: Path) -> np.ndarray:
+    """A float32 H x W disparity from NAME.npy or a 16-bit PNG (scaled to [0, 1])."""
+    if path.suffix == ".npy":
+        return np.load(path).astype(np.float32)
+    from PIL import Image
+    with Image.open(path) as image:
+        return np.asarray(image, dtype=np.float32) / 65535.0
+
+
+def make_source(spec: str, size, held_out: set = frozenset()):
     if spec == "scenes":
         return SceneSource(size)
     if spec == "cards":
         return CardSource(size)
     if spec.startswith("pairs:"):
-        return PairFolderSource(spec[len("pairs:"):], size)
-    raise ValueError(f"unknown data source {spec!r} (scenes | cards | pairs:DIR)")
+        return PairFolderSource.from_folder(spec[len("pairs:"):], size)
+    if spec.startswith("distilled:"):
+        return PairFolderSource.from_labels(spec[len("distilled:"):], size, held_out)
+    raise ValueError(f"unknown data source {spec!r} (scenes | cards | pairs:DIR | distilled:LABELS)")
 
 
 def make_batch(source, first_index: int, batch: int, validation: bool, rng: random.Random):
@@ -312,10 +350,13 @@ def train(args):
     run = Path(args.run)
     run.mkdir(parents=True, exist_ok=True)
     size = parse_size(args.size)
-    source = make_source(args.data, size)
+    import photo_folder  # the photo folder
+    held_out = set()
+    if args.data.startswith("distilled:"):
+        held_out = ordinal_data.validation_photos(photo_folder.photo_root(), args.ordinal or ordinal_data.ORDINAL_FILE)
+    source = make_source(args.data, size, held_out)
     ordinal_train = ordinal_val = None
     if args.ordinal:
-        import photo_folder  # the photo folder
         ordinal_train = ordinal_data.load_split("train", photo_folder.photo_root(), args.ordinal)
         ordinal_val = ordinal_data.load_split("val", photo_folder.photo_root(), args.ordinal)
     best_of = "ordinal_whdr" if ordinal_val else "val_loss"  # what best.pt keeps the lowest of
@@ -394,7 +435,7 @@ def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--model", choices=sorted(depth_model.ARCHITECTURES), default="lite")
     p.add_argument("--run", required=True, help="run folder: checkpoint.pt and train.log")
-    p.add_argument("--data", default="scenes", help="scenes | cards | pairs:DIR")
+    p.add_argument("--data", default="scenes", help="scenes | cards | pairs:DIR | distilled:LABELS")
     p.add_argument("--size", default="256x192", help="WIDTHxHEIGHT, multiples of 32")
     p.add_argument("--batch", type=int, default=4)
     p.add_argument("--steps", type=int, default=20000, help="total steps (a resumed run continues to this)")
