@@ -24,6 +24,7 @@ and the output resized back bilinearly (align_corners=True) to the photo's size.
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -150,7 +151,7 @@ def interpolate_pos_embed(pos_embed: torch.Tensor, rows: int, cols: int, offset:
     (rows + offset) / G and (cols + offset) / G, so the output is rows x cols but the
     sample positions follow the offset scale, src = (i + 0.5) * G / (rows + offset) - 0.5.
     A grid equal to G x G is returned unchanged (no resampling at all)."""
-    grid = int(round((pos_embed.shape[1] - 1) ** 0.5))
+    grid = math.isqrt(int(pos_embed.shape[1]) - 1)  # int(): a plain number under ONNX tracing too
     if rows == grid and cols == grid:
         return pos_embed
     dim = pos_embed.shape[-1]

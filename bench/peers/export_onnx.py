@@ -34,7 +34,7 @@ def parse_size(text: str):
 
 def export(ampw: str, onnx_path: str, width: int, height: int) -> None:
     model = peer_net.load(ampw)
-    multiple = model.net.multiple
+    multiple = model.multiple
     if width % multiple or height % multiple:
         raise SystemExit(f"export_onnx.py: {width}x{height} is not a multiple of {multiple}")
     tmp = onnx_path + ".tmp"

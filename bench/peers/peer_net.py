@@ -1,4 +1,9 @@
-"""The depth network of an .ampw file as the peers run it: PyTorch, BatchNorm folded.
+"""The depth network of an .ampw file as the peers run it, in PyTorch: RGB [1, 3, H, W]
+in [0, 1] -> disparity [1, 1, H, W], with `multiple` the sides must be multiples of.
+
+Depth Anything V2 files (arch ampi.depth.dav2-vit-dpt) run as our twin of the reference
+model (training/depth_anything.py) rebuilt from the file, LayerScale folded as the file
+holds it. The bundled families:
 
 training/export_depth.import_ampw rebuilds the PyTorch network from a weight file; the
 file's convolutions already hold their BatchNorm, and import_ampw leaves each BatchNorm
@@ -18,7 +23,11 @@ import torch.nn as nn
 REPO = Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(REPO / "training"))
 import depth_model  # noqa: E402
+import import_depth_anything  # noqa: E402
 from export_depth import import_ampw  # noqa: E402
+
+sys.path.insert(0, str(REPO / "weights_format"))
+from ampw import read_ampw  # noqa: E402
 
 
 def fold_batchnorm(conv: nn.Conv2d, bn: nn.BatchNorm2d) -> None:
@@ -51,6 +60,7 @@ class FinalDisparity(nn.Module):
     def __init__(self, net: depth_model.DepthNet):
         super().__init__()
         self.net = net
+        self.multiple = net.multiple
 
     def forward(self, rgb):
         net = self.net
@@ -81,7 +91,26 @@ def haar_idwt(x):
     return torch.stack([top, bottom], dim=3).reshape(n, c, 2 * h, 2 * w)
 
 
-def load(ampw_path: str) -> FinalDisparity:
+class DepthAnythingDisparity(nn.Module):
+    """Depth Anything V2 on an image whose sides are multiples of 14 (the working size the
+    benchmark gives it, so no resize): normalisation, then the twin."""
+
+    def __init__(self, model, mean, std):
+        super().__init__()
+        self.model = model
+        self.multiple = model.cfg.patch_size
+        self.register_buffer("mean", torch.tensor(mean, dtype=torch.float32).view(1, 3, 1, 1))
+        self.register_buffer("std", torch.tensor(std, dtype=torch.float32).view(1, 3, 1, 1))
+
+    def forward(self, rgb):
+        return self.model((rgb - self.mean) / self.std)[:, None]
+
+
+def load(ampw_path: str) -> nn.Module:
+    meta = read_ampw(ampw_path)[0]
+    if meta.get("arch") == import_depth_anything.ARCH_NAME:
+        model = import_depth_anything.import_ampw(ampw_path)
+        return DepthAnythingDisparity(model, meta["depth.input_mean"], meta["depth.input_std"]).eval()
     net = import_ampw(ampw_path)
     fold_all(net)
     return FinalDisparity(net).eval()

@@ -10,7 +10,13 @@ relative to the range of ampi's output: the proof that they ran the same network
 
 --smoke runs a tiny case (64x64) and only checks the differences against --tolerance:
 the ctest test peers_smoke. Any engine that is missing or fails stops the run with its
-error (exit 1): a peer is never skipped.
+error (exit 1): a peer is never skipped. The one exception is written into the table:
+OpenCV 4.6's ONNX importer cannot read the Depth Anything V2 export, so its cells of
+those rows say so, with the importer's message.
+
+Depth Anything V2 rows (--models vits, vitb or vitl) run a random-weight model made the
+documented way (training/random_depth_anything.py, then import_depth_anything.py) at
+--vit-sizes: the real checkpoint cannot be downloaded here, and the speed is the same.
 """
 from __future__ import annotations
 
@@ -38,6 +44,12 @@ PEER_TITLES = {"onnxruntime": "ONNX Runtime", "opencv-dnn": "OpenCV DNN", "pytor
 # The issue's targets: ampi's latency at most this fraction of the peer's (lite, 1024x768, 2 threads).
 TARGETS = {"onnxruntime": 0.8, "opencv-dnn": 0.5, "pytorch": 0.3}
 TARGET_CASE = ("lite", (1024, 768), 2)
+# Depth Anything V2's targets (ViT-S at 518x518, 2 threads); OpenCV DNN cannot run it.
+VIT_TARGETS = {"onnxruntime": 0.8, "pytorch": 0.5}
+VIT_TARGET_CASE = ("vits", (518, 518), 2)
+VIT_VARIANTS = ("vits", "vitb", "vitl")
+# Engines whose failure on a family is reported in the table instead of stopping the run.
+MAY_FAIL = {"vit": ("opencv-dnn",)}
 
 
 def parse_size(text: str):
@@ -57,6 +69,10 @@ def parse_sizes_runs(text: str):
 def fail(message: str):
     print(f"run_peers.py: {message}", file=sys.stderr)
     sys.exit(1)
+
+
+class EngineFailed(RuntimeError):
+    pass
 
 
 # ---- inputs and exports -------------------------------------------------------------------
@@ -83,21 +99,53 @@ def export_onnx(weights: Path, padded_size, folder: Path) -> Path:
     sources = [weights, HERE / "export_onnx.py", HERE / "peer_net.py"]
     if onnx.exists() and all(onnx.stat().st_mtime >= s.stat().st_mtime for s in sources):
         return onnx
-    run_checked([sys.executable, str(HERE / "export_onnx.py"), str(weights), str(onnx), "--size", f"{wp}x{hp}"],
-                f"ONNX export of {weights.name} at {wp}x{hp}")
+    try:
+        run_checked([sys.executable, str(HERE / "export_onnx.py"), str(weights), str(onnx), "--size", f"{wp}x{hp}"],
+                    f"ONNX export of {weights.name} at {wp}x{hp}")
+    except EngineFailed as e:
+        fail(str(e))
     return onnx
+
+
+def random_vit(variant: str, folder: Path) -> Path:
+    """A random-weight Depth Anything V2 file of `variant`, made as a user makes one from
+    a download (a checkpoint, then the importer); kept in `folder` for later runs."""
+    ampw = folder / f"dav2_random_{variant}.ampw"
+    if ampw.exists():
+        return ampw
+    pth = folder / f"dav2_random_{variant}.pth"
+    try:
+        run_checked([sys.executable, str(REPO / "training" / "random_depth_anything.py"), variant, str(pth)],
+                    f"random {variant} checkpoint")
+        run_checked([sys.executable, str(REPO / "training" / "import_depth_anything.py"), str(pth), str(ampw)],
+                    f"import of the random {variant} checkpoint")
+    except EngineFailed as e:
+        fail(str(e))
+    pth.unlink()
+    return ampw
+
+
+def weights_of(model: str, folder: Path) -> Path:
+    if model in VIT_VARIANTS:
+        return random_vit(model, folder)
+    weights = REPO / "weights" / f"depth_{model}.ampw"
+    if not weights.is_file():
+        fail(f"{weights}: no such weight file")
+    return weights
 
 
 # ---- engines ------------------------------------------------------------------------------
 
 def run_checked(cmd, what: str) -> str:
+    """The command's stdout; EngineFailed (its first error line) when it fails."""
     try:
         proc = subprocess.run(cmd, capture_output=True, text=True, cwd=REPO)
     except OSError as e:
-        fail(f"{what}: cannot start {cmd[0]}: {e.strerror}")
+        raise EngineFailed(f"{what}: cannot start {cmd[0]}: {e.strerror}")
     if proc.returncode != 0:
         err = (proc.stderr or proc.stdout).strip().splitlines()
-        fail(f"{what} failed (exit {proc.returncode}): {err[-1] if err else 'no message'}\n  command: {' '.join(cmd)}")
+        raise EngineFailed(f"{what} failed (exit {proc.returncode}): {err[0] if err else 'no message'}"
+                           f"\n  command: {' '.join(cmd)}")
     return proc.stdout
 
 
@@ -181,32 +229,48 @@ def pool_timings(pooled: dict, results: dict):
         pooled[threads]["foreign_cores"] = max(loads) if loads else None
 
 
-def measure_case(args, weights: Path, size, runs: int, folder: Path, multiple: int) -> dict:
+def measure_case(args, model: str, weights: Path, size, runs: int, folder: Path, multiple: int) -> dict:
     """One network and size: --rounds rounds, each running every engine once in turn, so
     a slow spell of a shared machine falls on every engine rather than on whichever ran
     then; each engine's timings are pooled over the rounds. The outputs of the last round
-    are compared."""
+    are compared. An engine of MAY_FAIL that fails is recorded in case["failed"] and not
+    run again."""
     hwc, nchw, padded = make_inputs(args.photo, size, multiple, folder)
     onnx = export_onnx(weights, padded, folder)
     save = folder / f"out_{weights.stem}_{size[0]}x{size[1]}"
-    case = {"model": weights.stem.replace("depth_", ""), "size": size, "padded": padded,
-            "runs": rounds_runs(runs, args.rounds) * args.rounds, "engines": {}, "diff": {}, "range": {}}
+    case = {"model": model, "size": size, "padded": padded, "runs": rounds_runs(runs, args.rounds) * args.rounds,
+            "engines": {}, "diff": {}, "range": {}, "failed": {}}
+    may_fail = MAY_FAIL["vit"] if model in VIT_VARIANTS else ()
     commands = engine_commands(args, weights, onnx, hwc, nchw, rounds_runs(runs, args.rounds), save)
     for round_index in range(args.rounds):
         for name, cmd in commands.items():
-            print(f"  {case['model']} {size[0]}x{size[1]}: {name} (round {round_index + 1} of {args.rounds}) ...",
+            if name in case["failed"]:
+                continue
+            print(f"  {model} {size[0]}x{size[1]}: {name} (round {round_index + 1} of {args.rounds}) ...",
                   file=sys.stderr, flush=True)
-            pool_timings(case["engines"].setdefault(name, {}), run_engine(name, cmd, args))
+            try:
+                pool_timings(case["engines"].setdefault(name, {}), run_engine(name, cmd, args))
+            except EngineFailed as e:
+                if name not in may_fail:
+                    fail(str(e))
+                case["engines"].pop(name, None)
+                case["failed"][name] = str(e).splitlines()[0]
     for t in args.threads:
         ampi = np.load(f"{save}_ampi.t{t}.npy").astype(np.float64)
         case["range"][t] = (float(ampi.min()), float(ampi.max()))
         for peer in PEERS:
-            case["diff"].setdefault(peer, {})[t] = relative_difference(np.load(f"{save}_{peer}.t{t}.npy"), ampi)
+            if peer not in case["failed"]:
+                case["diff"].setdefault(peer, {})[t] = relative_difference(np.load(f"{save}_{peer}.t{t}.npy"), ampi)
     return case
 
 
 def median_ms(case, engine, threads) -> float:
     return statistics.median(case["engines"][engine][threads]["ms"])
+
+
+def failed(case, engine) -> bool:
+    """Whether `engine` could not run this case (MAY_FAIL): its cells say n/a."""
+    return engine in case.get("failed", {})
 
 
 # ---- the table ----------------------------------------------------------------------------
@@ -250,20 +314,27 @@ def busy(case, engine, args) -> bool:
 
 
 def targets_section(cases, args) -> list:
-    model, size, threads = TARGET_CASE
+    return (target_table(cases, args, TARGET_CASE, TARGETS)
+            + target_table(cases, args, VIT_TARGET_CASE, VIT_TARGETS))
+
+
+def target_table(cases, args, target_case, targets) -> list:
+    model, size, threads = target_case
     case = next((c for c in cases if c["model"] == model and tuple(c["size"]) == size), None)
+    if case is None and model in VIT_VARIANTS:
+        return []  # no ViT in this run
     lines = [f"## Targets: ampi {model} at {size[0]}x{size[1]}, {threads} threads", ""]
     if case is None or threads not in case["engines"]["ampi"]:
         return lines + ["Not measured in this run (the target case was not among the sizes and threads).", ""]
     ampi = median_ms(case, "ampi", threads)
     lines += ["| peer | target (ampi / peer) | ampi (ms) | peer (ms) | measured ratio | |", "|---|---:|---:|---:|---:|---|"]
-    for peer in PEERS:
+    for peer, target in targets.items():
         ms = median_ms(case, peer, threads)
         ratio = ampi / ms
-        verdict = "**met**" if ratio <= TARGETS[peer] else "**not met**"
+        verdict = "**met**" if ratio <= target else "**not met**"
         if busy(case, "ampi", args) or busy(case, peer, args):
             verdict = "undecided: not timed on a quiet machine (see the check below)"
-        lines.append(f"| {PEER_TITLES[peer]} | <= {TARGETS[peer]:.1f}x | {ampi:.1f} | {ms:.1f} | {ratio:.2f}x | {verdict} |")
+        lines.append(f"| {PEER_TITLES[peer]} | <= {target:.1f}x | {ampi:.1f} | {ms:.1f} | {ratio:.2f}x | {verdict} |")
     return lines + [""]
 
 
@@ -278,13 +349,23 @@ def latency_section(cases, args) -> list:
     for case in cases:
         for t in threads_list:
             ampi = median_ms(case, "ampi", t)
-            peers = [median_ms(case, p, t) for p in PEERS]
+            ran = [p for p in PEERS if not failed(case, p)]
+            times = {p: median_ms(case, p, t) for p in ran}
+            mark = {e: "*" if busy(case, e, args) else "" for e in ("ampi",) + tuple(ran)}
             w, h = case["size"]
-            mark = {e: "*" if busy(case, e, args) else "" for e in ("ampi",) + PEERS}
             lines.append(f"| {case['model']} | {w}x{h} | {t} | {case['runs']} | {ampi:.1f}{mark['ampi']} | "
-                         + " | ".join(f"{ms:.1f}{mark[p]}" for p, ms in zip(PEERS, peers)) + " | "
-                         + " | ".join(f"{ampi / ms:.2f}" for ms in peers) + " |")
-    return lines + [""] + single_thread_note(cases, threads_list)
+                         + " | ".join(f"{times[p]:.1f}{mark[p]}" if p in times else "n/a" for p in PEERS) + " | "
+                         + " | ".join(f"{ampi / times[p]:.2f}" if p in times else "n/a" for p in PEERS) + " |")
+    return lines + [""] + failure_notes(cases) + single_thread_note(cases, threads_list)
+
+
+def failure_notes(cases) -> list:
+    """Why an n/a: each engine that could not run a case, with its first error line."""
+    notes = []
+    for case in cases:
+        for engine, error in case.get("failed", {}).items():
+            notes.append(f"n/a: {PEER_TITLES[engine]} could not run {case['model']} ({error}).")
+    return notes + [""] if notes else []
 
 
 def single_thread_note(cases, threads_list) -> list:
@@ -294,8 +375,8 @@ def single_thread_note(cases, threads_list) -> list:
         return []
     notes = []
     for peer in PEERS:
-        ratios = [median_ms(c, peer, 1) / median_ms(c, peer, 2) for c in cases]
-        if max(ratios) > 3:
+        ratios = [median_ms(c, peer, 1) / median_ms(c, peer, 2) for c in cases if not failed(c, peer)]
+        if ratios and max(ratios) > 3:
             notes.append(f"{PEER_TITLES[peer]}'s 1-thread median is {min(ratios):.1f}x to {max(ratios):.1f}x its "
                          "2-thread median here (bench/peers/README.md says why).")
     return notes + [""] if notes else []
@@ -310,8 +391,8 @@ def difference_section(cases, threads_list) -> list:
         w, h = case["size"]
         lo = min(case["range"][t][0] for t in threads_list)
         hi = max(case["range"][t][1] for t in threads_list)
-        diffs = [max(case["diff"][p].values()) for p in PEERS]
-        lines.append(f"| {case['model']} | {w}x{h} | {lo:.3f} .. {hi:.3f} | " + " | ".join(f"{d:.1e}" for d in diffs) + " |")
+        diffs = ["n/a" if failed(case, p) else f"{max(case['diff'][p].values()):.1e}" for p in PEERS]
+        lines.append(f"| {case['model']} | {w}x{h} | {lo:.3f} .. {hi:.3f} | " + " | ".join(diffs) + " |")
     return lines + [""]
 
 
@@ -329,7 +410,7 @@ def quiet_section(cases, args) -> list:
         w, h = case["size"]
         cells = []
         for engine in engines:
-            foreign = foreign_cores(case, engine)
+            foreign = None if failed(case, engine) else foreign_cores(case, engine)
             cells.append("n/a" if foreign is None else f"{foreign:.2f}")
         lines.append(f"| {case['model']} | {w}x{h} | " + " | ".join(cells) + " |")
     return lines + [""]
@@ -343,7 +424,7 @@ def wrap_note(args) -> str:
 
 
 # The settings a report states, kept with the raw timings so --report-from can re-make it.
-REPORT_SETTINGS = ("models", "sizes", "threads", "warmup", "rounds", "wrap", "max_foreign", "retries", "wait_quiet", "commit")
+REPORT_SETTINGS = ("models", "sizes", "vit_sizes", "threads", "warmup", "rounds", "wrap", "max_foreign", "retries", "wait_quiet", "commit")
 
 
 def save_raw(args, cases, seconds: float):
@@ -366,6 +447,7 @@ def load_raw(args, path: Path):
     for case in cases:  # JSON turned the thread counts into strings
         case["engines"] = {e: {int(t): r for t, r in by.items()} for e, by in case["engines"].items()}
         case["diff"] = {p: {int(t): d for t, d in by.items()} for p, by in case["diff"].items()}
+        case.setdefault("failed", {})
         case["range"] = {int(t): tuple(r) for t, r in case["range"].items()}
     return cases, raw["seconds"]
 
@@ -376,7 +458,7 @@ def write_results(args, cases, seconds: float):
     pad_note = ""
     if padded:
         c = padded[0]
-        pad_note = (f" Sizes that are not multiples of the network's {args.multiple} (e.g. {c['size'][0]}x{c['size'][1]}) "
+        pad_note = (f" Sizes that are not multiples of the network's multiple (e.g. {c['size'][0]}x{c['size'][1]}) "
                     f"run at {c['padded'][0]}x{c['padded'][1]}: ampi pads inside its timed run (edge replication), "
                     "the peers get the image padded the same way before timing (their export has that size), "
                     "and their outputs are cropped back for the comparison.")
@@ -388,7 +470,7 @@ def write_results(args, cases, seconds: float):
         f"--warmup {args.warmup} --rounds {args.rounds}`{wrap_note(args)}; rerun it to refresh this file.", "",
         f"- Machine: {cpu_model()}, {os.cpu_count()} cores; ampi's kernels: {v['isa']}.",
         "- Engines, all on the CPU, the same thread count each (1, then 2):",
-        "  ampi (`ampi bench network`, DepthNet::run on its own kernels);",
+        "  ampi (`ampi bench network`, DepthModel::run on its own kernels);",
         f"  ONNX Runtime {v['ort']} (npm's onnxruntime-node, CPU provider, all graph optimisations, "
         "intra-op threads = T, inter-op 1);",
         f"  OpenCV {opencv_version(args.opencv_peer)} DNN (Debian's, OpenCV backend, `cv::setNumThreads(T)`);",
@@ -396,7 +478,10 @@ def write_results(args, cases, seconds: float):
         "`torch.set_num_threads(T)`).",
         "- The same network for all: the weight file `weights/depth_*.ampw`; ONNX Runtime and OpenCV run "
         "its ONNX export with BatchNorm folded (bench/peers/export_onnx.py), PyTorch the same folded "
-        "network rebuilt from the file (bench/peers/peer_net.py).",
+        "network rebuilt from the file (bench/peers/peer_net.py). Depth Anything V2 rows (vits, vitb, vitl) "
+        "run a random-weight file made the way a user converts a download (training/random_depth_anything.py, "
+        "then training/import_depth_anything.py; same speed as the real weights), PyTorch as our twin of "
+        "the reference model (training/depth_anything.py) rebuilt from that file.",
         f"- Input: `{args.photo.relative_to(REPO) if args.photo.is_relative_to(REPO) else args.photo}` resized "
         "to each size, RGB in [0, 1], the same pixels for every engine; each engine times the network "
         "call alone (input normalisation included, loading excluded), wall clock, after "
@@ -423,6 +508,9 @@ def main(argv=None):
     p.add_argument("--models", default="lite,heavy")
     p.add_argument("--sizes", default="512x384:9,1024x768:7,1920x1080:5",
                    help="WxH:RUNS,... (timed runs per thread count)")
+    p.add_argument("--vit-sizes", default="518x518:3",
+                   help="WxH:RUNS,... of the Depth Anything V2 models (vits, vitb, vitl in --models); "
+                        "multiples of 14")
     p.add_argument("--threads", default="1,2")
     p.add_argument("--warmup", type=int, default=1)
     p.add_argument("--rounds", type=int, default=3,
@@ -457,12 +545,11 @@ def main(argv=None):
     start, args.commit = time.time(), git_commit()
     cases = []
     for model in args.models.split(","):
-        weights = REPO / "weights" / f"depth_{model}.ampw"
-        if not weights.is_file():
-            fail(f"{weights}: no such weight file")
-        args.multiple = int(read_ampw(str(weights))[0]["depth.multiple"])
-        for size, runs in parse_sizes_runs(args.sizes):
-            cases.append(measure_case(args, weights, size, runs, args.work, args.multiple))
+        weights = weights_of(model, args.work)
+        multiple = int(read_ampw(str(weights))[0]["depth.multiple"])
+        sizes = args.vit_sizes if model in VIT_VARIANTS else args.sizes
+        for size, runs in parse_sizes_runs(sizes):
+            cases.append(measure_case(args, model, weights, size, runs, args.work, multiple))
 
     if args.smoke:
         worst = max(max(c["diff"][p].values()) for c in cases for p in PEERS)
