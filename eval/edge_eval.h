@@ -43,7 +43,7 @@ struct EdgeScene {
   cv::Mat disparity;                  // CV_32FC1: the exact map (each pixel its frontmost surface's)
 };
 
-// The scene set: a disk (the scene), a thin pole, a person-like silhouette and
+// The scene set: a disk (the plainest case of a torn edge), a thin pole, a person-like silhouette and
 // two objects at different depths, at `size`. Textures are smooth noise in separate hues
 // (background green-grey, objects red and blue) from `seed`; with a `texture_photo`
 // (CV_8UC3) they are crops of it instead.

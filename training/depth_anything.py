@@ -1,6 +1,6 @@
 """Depth Anything V2 (Yang et al. 2024) in PyTorch: our own twin of the reference model.
 
-The teacher of the paper's distillation (issue 22). A DINOv2 vision transformer encodes
+The teacher of the paper's distillation (`ampi distill`). A DINOv2 vision transformer encodes
 the image as 14x14 patches; a DPT head turns the tokens of four of its blocks into a
 relative inverse-depth map (larger = nearer) at the input resolution:
 

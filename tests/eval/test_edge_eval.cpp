@@ -1,6 +1,6 @@
 // eval/edge_eval.h: scenes whose new views are known exactly, and the judge that traces
-// what an MPI shows. The exact MPI scores nothing wrong; the scene (a disk over
-// a background, its map made at a quarter of the size) tears without edge snapping and
+// what an MPI shows. The exact MPI scores nothing wrong; the disk scene (a disk over a
+// background, its map made at a quarter of the size) tears without edge snapping and
 // stays whole with it.
 #include <catch2/catch.hpp>
 
@@ -88,7 +88,7 @@ TEST_CASE("the exact MPI scores nothing wrong at any pose") {
   }
 }
 
-TEST_CASE("the issue's scene: torn without edge snapping, whole with it") {
+TEST_CASE("the disk scene: torn without edge snapping, whole with it") {
   const Camera camera = camera_from_fov(kSize.width, kSize.height, 60);
   const std::vector<EdgeScene> scenes = edge_scenes(kSize, 1);
   const EdgeScene& disk = scene_named(scenes, "disk");
