@@ -764,7 +764,7 @@ void time_families(const std::vector<Isa>& isas, ThreadPool& pool, const Options
   }
 }
 
-// The targets, for the best ISA: 1x1 convolutions with >= 64 channels on both
+// The targets, for the best ISA: 1x1 convolutions with >= 64 channels on both
 // sides at >= 60% of the FMA peak, depthwise ones at >= 50% of the bandwidth (the
 // whole network's 2-thread scaling, scaling_target, follows them).
 std::string targets(const std::vector<Layer>& layers, const std::vector<Timing>& best, const Limits& lim,

@@ -243,7 +243,7 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
   }
   md << "\n\nThe warm rows time the depth network alone (on the photo already shrunk to the\n"
      << "working size) and the slicer on its output alternately, " << kSlicingShareReps
-     << " times each, medians: the\ncomparison issue 6 asks for. In the run, the slicer's buffers are touched for the\n"
+     << " times each, medians: the\nslicer's share of the network's time. In the run, the slicer's buffers are touched for the\n"
      << "first time after the heap was handed back (page faults), while the network's arena\n"
      << "persists, and the depth stage includes shrinking the photo.\n\n"
      << "Depth edges (slicing/depth_edges.h) are on, as in `ampi run`. Their cost: after every\n"

@@ -147,7 +147,7 @@ def ordinal_table(ampi, threads):
         gain = 100 * (gradient - whdr)
         side = 'below (better than)' if gain > 0 else 'above (worse than)'
         lines.append(f'\n{model} on the validation photos: WHDR {whdr:.4f}, {abs(gain):.1f} points {side} the '
-                     f'vertical gradient\'s {gradient:.4f} (issue 23\'s target for lite: at least 10 below).')
+                     f'vertical gradient\'s {gradient:.4f} (the target for lite: at least 10 below).')
     lines += ['', 'The outputs these rows are copied from:', '']
     for split, model, command, out, seconds in runs:
         lines += [f'## {model}, {split}', '', f'`{command}` ({seconds:.0f} s)', '', '```', out.rstrip(), '```', '']
@@ -343,7 +343,7 @@ def slicing_table(ampi, threads, scene_count, extra):
         '',
         *fenced(exact_out),
         '',
-        'Target (issue 10): adaptive at or above uniform at every count. Result on the validation',
+        'Target: adaptive at or above uniform at every count. Result on the validation',
         f'photos: {verdict_of(out)}; without edge snapping: {verdict_of(no_snap_out)};',
         f'with the paper\'s rule exactly: {verdict_of(paper_out)};',
         f'with exact depth: {verdict_of(exact_out)}.',
@@ -379,7 +379,7 @@ def edges_table(ampi, threads):
         '',
         'Made by `/usr/bin/python3 eval/make_tables.py edges --ampi AMPI`. Scenes of textured',
         'fronto-parallel surfaces whose new views are known exactly (`eval/edge_eval.h`): a disk',
-        'over a background (issue 25\'s scene), a thin pole, a person-like silhouette, two objects',
+        'over a background (the README's scene), a thin pole, a person-like silhouette, two objects',
         'at different depths; 640x480, disparity 1 (and 0.6) over 0.25. Each scene\'s disparity map',
         'is made soft (reduced 4 or 8 times and enlarged bilinearly, as a network\'s map is; or',
         'hard) and made into an MPI as `ampi run --depth` does (8 planes at most, the inpainting',

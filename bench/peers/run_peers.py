@@ -41,7 +41,7 @@ from ampw import read_ampw  # noqa: E402
 
 PEERS = ("onnxruntime", "opencv-dnn", "pytorch")
 PEER_TITLES = {"onnxruntime": "ONNX Runtime", "opencv-dnn": "OpenCV DNN", "pytorch": "PyTorch"}
-# The issue's targets: ampi's latency at most this fraction of the peer's (lite, 1024x768, 2 threads).
+# The targets: ampi's latency at most this fraction of the peer's (lite, 1024x768, 2 threads).
 TARGETS = {"onnxruntime": 0.8, "opencv-dnn": 0.5, "pytorch": 0.3}
 TARGET_CASE = ("lite", (1024, 768), 2)
 # Depth Anything V2's targets (ViT-S at 518x518, 2 threads); OpenCV DNN cannot run it.
