@@ -71,7 +71,7 @@ class Kernel:
 # steady state's FMAs (the compiler also emits edge and tail loops, and a copy per
 # activation), the one with the fewest instructions.
 KERNELS = [
-    Kernel("GEMM 8x8 tile", "kernels/arm/conv_gemm_neon.cpp", "panel_tileILi2E", 8 * 2 * 4,  # rows x vectors x k steps
+    Kernel("GEMM 8x8 tile", "kernels/arm/conv_gemm_neon.cpp", "10panel_tile", 8 * 2 * 4,  # rows x vectors x k steps
            "k loop of the 8-row x 8-column tile, 4 steps of k (1x1 and im2col convolutions)"),
     Kernel("depthwise 3x3 s1", "kernels/arm/conv_depthwise_neon.cpp", "FixedGeometryILi3ELi1E", 8 * 9,  # pixels x taps
            "8 output pixels x one channel vector x 9 taps, 3x3 stride 1"),
