@@ -78,9 +78,12 @@ template <bool kChecked, int K, int S, class Lane, class V>
     if (!row) continue;
     V w[K];
     for (int kx = 0; kx < K; ++kx) w[kx] = lane.load(d.weights + (static_cast<int64_t>(ky) * K + kx) * c + ch);
+    // kStepColumns (each ISA's *_channels.h): unchecked columns read through a pointer
+    // stepping one pixel at a time instead of each indexed from ix0.
+    const float* next = row + static_cast<int64_t>(ix0) * c + ch;
 #pragma GCC unroll 32
-    for (int j = 0; j < kColumns; ++j) {
-      V x = column<kChecked>(d, row, ix0 + j, ch, lane);
+    for (int j = 0; j < kColumns; ++j, next += c) {
+      V x = (kStepColumns && !kChecked) ? lane.load(next) : column<kChecked>(d, row, ix0 + j, ch, lane);
       keep_in_register(x);  // one load per column, not one per tap (avx512_channels.h)
 #pragma GCC unroll 8
       for (int kx = 0; kx < K; ++kx) {

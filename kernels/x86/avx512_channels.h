@@ -40,6 +40,12 @@ inline __m512 fmadd(__m512 a, __m512 b, __m512 c) { return _mm512_fmadd_ps(a, b,
 template <class V>
 inline void keep_in_register(V& v) { asm("" : "+v"(v)); }
 
+// Depthwise interior columns read through a stepping pointer (kernels/depthwise_lanes.inl):
+// indexed from the block's first column, each load's address cost a 64-bit multiply-add;
+// 3x3 s1 over 512x384x64 went from 9.7 to 3.7-4.4 ms (`ampi bench kernels`, cpu clock,
+// alternating runs), the other depthwise rows unchanged within noise.
+constexpr bool kStepColumns = true;
+
 class Channels {
  public:
   explicit Channels(int c)
