@@ -43,6 +43,14 @@ inline float32x4_t sigmoid(float32x4_t x) {
   return vdivq_f32(one, vaddq_f32(one, exp(vnegq_f32(x))));
 }
 
+// GELU lane by lane through the scalar reference's formula (kernels/activation.h).
+inline float32x4_t gelu(float32x4_t x) {
+  alignas(16) float v[4];
+  vst1q_f32(v, x);
+  for (float& f : v) f = ampi::gelu(f);
+  return vld1q_f32(v);
+}
+
 inline float32x4_t activate(float32x4_t x, ActivationSpec a) {
   const float32x4_t zero = vdupq_n_f32(0.0f);
   switch (a.kind) {
@@ -66,6 +74,7 @@ inline float32x4_t activate(float32x4_t x, ActivationSpec a) {
       const float32x4_t s = sigmoid(vaddq_f32(x, x));
       return vsubq_f32(vaddq_f32(s, s), vdupq_n_f32(1.0f));
     }
+    case Activation::GELU: return gelu(x);
   }
   return x;
 }

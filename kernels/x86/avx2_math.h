@@ -46,6 +46,14 @@ inline __m256 sigmoid(__m256 x) {
   return _mm256_div_ps(one, _mm256_add_ps(one, exp(_mm256_sub_ps(_mm256_setzero_ps(), x))));
 }
 
+// GELU lane by lane through the scalar reference's formula (kernels/activation.h).
+inline __m256 gelu(__m256 x) {
+  alignas(32) float v[8];
+  _mm256_store_ps(v, x);
+  for (float& f : v) f = ampi::gelu(f);
+  return _mm256_load_ps(v);
+}
+
 inline __m256 activate(__m256 x, ActivationSpec a) {
   const __m256 zero = _mm256_setzero_ps();
   switch (a.kind) {
@@ -73,6 +81,7 @@ inline __m256 activate(__m256 x, ActivationSpec a) {
       const __m256 s = sigmoid(_mm256_add_ps(x, x));
       return _mm256_sub_ps(_mm256_add_ps(s, s), _mm256_set1_ps(1.0f));
     }
+    case Activation::GELU: return gelu(x);
   }
   return x;
 }

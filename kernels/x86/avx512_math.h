@@ -42,6 +42,14 @@ inline __m512 sigmoid(__m512 x) {
   return _mm512_div_ps(one, _mm512_add_ps(one, exp(_mm512_sub_ps(_mm512_setzero_ps(), x))));
 }
 
+// GELU lane by lane through the scalar reference's formula (kernels/activation.h).
+inline __m512 gelu(__m512 x) {
+  alignas(64) float v[16];
+  _mm512_store_ps(v, x);
+  for (float& f : v) f = ampi::gelu(f);
+  return _mm512_load_ps(v);
+}
+
 inline __m512 activate(__m512 x, ActivationSpec a) {
   const __m512 zero = _mm512_setzero_ps();
   switch (a.kind) {
@@ -69,6 +77,7 @@ inline __m512 activate(__m512 x, ActivationSpec a) {
       const __m512 s = sigmoid(_mm512_add_ps(x, x));
       return _mm512_sub_ps(_mm512_add_ps(s, s), _mm512_set1_ps(1.0f));
     }
+    case Activation::GELU: return gelu(x);
   }
   return x;
 }
