@@ -8,6 +8,7 @@
 //   slicing/row_kernel_list.def), naming the ISA whose code each table runs for it;
 // then the whole lite network with 1 and with 2 threads.
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <fstream>
@@ -662,6 +663,82 @@ FamilyWorkload snap_row_workload() {
           }};
 }
 
+// The transformer rows on a ViT-S/14 encoder at 518x518: 1370 tokens (37 x 37 patches and
+// the class token) of 384 channels, attention over 1370 keys in blocks of 256.
+constexpr int kVitTokens = 1370, kVitDim = 384, kVitKeyBlock = 256;
+
+FamilyWorkload layer_norm_workload() {
+  const int64_t n = int64_t{kVitTokens} * kVitDim;
+  return {{"layer_norm_row"}, "layer norm, " + std::to_string(kVitTokens) + " tokens x " + std::to_string(kVitDim),
+          8.0 * n, [n] {
+            auto in = shared_random({n}, 70), out = shared_zeros({n});
+            auto gamma = shared_random({kVitDim}, 71), beta = shared_random({kVitDim}, 72);
+            return FamilyCall([=](Isa isa, ThreadPool& pool) {
+              const KernelTable& k = kernels_for(isa);
+              pool.parallel_for(kVitTokens, 16, [&](int64_t begin, int64_t end) {
+                for (int64_t t = begin; t < end; ++t)
+                  k.layer_norm_row(in->f32() + t * kVitDim, kVitDim, gamma->f32(), beta->f32(), 1e-6f,
+                                   out->f32() + t * kVitDim);
+              });
+            });
+          }};
+}
+
+// Every query row's scores against all keys, block by block in place, as attention streams
+// them (one head: the 1370 x 1370 score matrix).
+FamilyWorkload softmax_workload() {
+  const int64_t n = int64_t{kVitTokens} * kVitTokens;
+  return {{"softmax_block_row"},
+          "online softmax, " + std::to_string(kVitTokens) + " queries x " + std::to_string(kVitTokens) +
+              " keys in blocks of " + std::to_string(kVitKeyBlock),
+          8.0 * n, [n] {
+            auto scores = shared_random({n}, 73, -8.0f, 8.0f);
+            return FamilyCall([=](Isa isa, ThreadPool& pool) {
+              const KernelTable& k = kernels_for(isa);
+              pool.parallel_for(kVitTokens, 16, [&](int64_t begin, int64_t end) {
+                for (int64_t q = begin; q < end; ++q) {
+                  float running_max = -INFINITY, running_sum = 0.0f;
+                  for (int k0 = 0; k0 < kVitTokens; k0 += kVitKeyBlock)
+                    k.softmax_block_row(scores->f32() + q * kVitTokens + k0, std::min(kVitKeyBlock, kVitTokens - k0),
+                                        0.125f, &running_max, &running_sum);
+                }
+              });
+            });
+          }};
+}
+
+// The DPT head's 2x resize (align_corners=True) of a 74x74x256 fusion map.
+constexpr int kDptIn = 74, kDptOut = 2 * kDptIn, kDptC = 256;
+
+FamilyWorkload bilinear_row_workload() {
+  constexpr int kIn = kDptIn, kOut = kDptOut, kC = kDptC;
+  const double bytes = 4.0 * (int64_t{kIn} * kIn * kC + int64_t{kOut} * kOut * kC);
+  return {{"bilinear_row"}, "bilinear resize (align corners), " + map_shape(kIn, kIn, kC) + " -> " + map_shape(kOut, kOut, kC),
+          bytes, [] {
+            auto in = shared_random({kIn, kIn, kC}, 74), out = shared_zeros({kOut, kOut, kC});
+            auto x0 = std::make_shared<std::vector<int32_t>>(kDptOut);
+            auto x1 = std::make_shared<std::vector<int32_t>>(kDptOut);
+            auto wx = std::make_shared<std::vector<float>>(kDptOut);
+            for (int x = 0; x < kOut; ++x) {
+              const float src = static_cast<float>(x) * (kIn - 1) / (kOut - 1);
+              (*x0)[x] = std::min(static_cast<int>(src), kIn - 1);
+              (*x1)[x] = std::min((*x0)[x] + 1, kIn - 1);
+              (*wx)[x] = src - (*x0)[x];
+            }
+            return FamilyCall([=](Isa isa, ThreadPool& pool) {
+              const KernelTable& k = kernels_for(isa);
+              const int64_t in_row = int64_t{kIn} * kC;
+              pool.parallel_for(kOut, 8, [&](int64_t begin, int64_t end) {
+                for (int64_t y = begin; y < end; ++y) {
+                  const int64_t sy = (*x0)[y], sy1 = (*x1)[y];  // the same rule down the rows
+                  k.bilinear_row(in->f32() + sy * in_row, in->f32() + sy1 * in_row, (*wx)[y], x0->data(),
+                                 x1->data(), wx->data(), kOut, kC, out->f32() + y * kOut * kC);
+                }
+              });
+            });
+          }};
+}
+
 std::vector<FamilyWorkload> family_workloads() {
   return {gemm_workload(),
           depthwise_workload(),
@@ -680,7 +757,10 @@ std::vector<FamilyWorkload> family_workloads() {
           range_row_workload(),
           normalize_row_workload(),
           bilateral_workload(),
-          snap_row_workload()};
+          snap_row_workload(),
+          layer_norm_workload(),
+          softmax_workload(),
+          bilinear_row_workload()};
 }
 
 // Every family of both lists, in their order, with the ISA each runnable table runs for it.

@@ -7,7 +7,8 @@
 namespace ampi {
 
 static const char* const kNames[] = {"none",        "relu",    "relu6",     "hardswish", "hardsigmoid",
-                                     "sigmoid",     "leakyrelu", "elu",     "tanh"};
+                                     "sigmoid",     "leakyrelu", "elu",     "tanh",
+                                     "gelu"};
 
 const char* activation_name(Activation a) { return kNames[static_cast<int>(a)]; }
 

@@ -4,9 +4,12 @@
 #include <algorithm>
 #include <cmath>
 
+#include "kernels/exp_polynomials.h"
+
 namespace ampi {
 
-enum class Activation { None, ReLU, ReLU6, HardSwish, HardSigmoid, Sigmoid, LeakyReLU, ELU, Tanh };
+// GELU is the exact (erf) form, torch.nn.GELU()'s default: 0.5 x (1 + erf(x / sqrt 2)).
+enum class Activation { None, ReLU, ReLU6, HardSwish, HardSigmoid, Sigmoid, LeakyReLU, ELU, Tanh, GELU };
 
 struct ActivationSpec {
   Activation kind = Activation::None;
@@ -15,13 +18,37 @@ struct ActivationSpec {
 
 const char* activation_name(Activation a);
 // Parses the names above in lower case ("none", "relu", "relu6", "hardswish",
-// "hardsigmoid", "sigmoid", "leakyrelu", "elu", "tanh"); throws std::invalid_argument.
+// "hardsigmoid", "sigmoid", "leakyrelu", "elu", "tanh", "gelu"); throws std::invalid_argument.
 Activation parse_activation(const char* name);
 
 // The vector activations compute the gate as clamp(x * (1/6) + 1/2, 0, 1), one FMA, where
 // this reference divides x + 3 by 6 (within a few ulp): a vector divide costs several FMAs'
 // time, and hardswish ends every GEMM tile and depthwise block of the depth network.
 constexpr float kOneSixth = 1.0f / 6.0f;
+
+// e^x by the vector exp's own steps (exp_polynomials.h): GELU's reference must evaluate
+// the formula the vector code does, so the two agree within a few ulp.
+inline float exp_polynomial(float x) {
+  using namespace exp_poly;
+  x = std::min(std::max(x, kMin), kMax);
+  const float n = std::nearbyint(x * kLog2e);
+  const float r = (x - n * kLn2Hi) - n * kLn2Lo;
+  float p = kExp[0];
+  for (size_t i = 1; i < sizeof(kExp) / sizeof(kExp[0]); ++i) p = p * r + kExp[i];
+  return std::ldexp(p * (r * r) + (r + 1.0f), static_cast<int>(n));
+}
+
+// gelu(x) = x Phi(x), Phi the standard normal CDF. Both signs go through the tail
+// h = Phi(-|x|) = erfc(|x| / sqrt 2) / 2, which keeps its relative accuracy where it is
+// tiny: Phi(x) = 1 - h for x >= 0, h for x < 0. h = exp(-x^2 / 2) Q(min(|x|, kMaxArg)),
+// Q the polynomial of exp_polynomials.h; h = 0 past kZeroArg.
+inline float gelu(float x) {
+  const float t = std::min(std::fabs(x), erfc_poly::kMaxArg) - erfc_poly::kCentre;
+  float q = erfc_poly::kQ[0];
+  for (size_t i = 1; i < sizeof(erfc_poly::kQ) / sizeof(erfc_poly::kQ[0]); ++i) q = q * t + erfc_poly::kQ[i];
+  const float h = std::fabs(x) > erfc_poly::kZeroArg ? 0.0f : exp_polynomial(-0.5f * (x * x)) * q;
+  return x * (x >= 0.0f ? 1.0f - h : h);
+}
 
 inline float activate(float x, ActivationSpec a) {
   switch (a.kind) {
@@ -34,6 +61,7 @@ inline float activate(float x, ActivationSpec a) {
     case Activation::LeakyReLU: return x >= 0.0f ? x : a.alpha * x;
     case Activation::ELU: return x >= 0.0f ? x : a.alpha * (std::exp(x) - 1.0f);
     case Activation::Tanh: return std::tanh(x);
+    case Activation::GELU: return gelu(x);
   }
   return x;
 }

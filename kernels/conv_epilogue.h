@@ -26,6 +26,7 @@ inline void activate_tile(Vec (&v)[N], ActivationSpec act, Activate activate) {
     case Activation::LeakyReLU: return activate_tile_as<Activation::LeakyReLU>(v, act.alpha, activate);
     case Activation::ELU: return activate_tile_as<Activation::ELU>(v, act.alpha, activate);
     case Activation::Tanh: return activate_tile_as<Activation::Tanh>(v, act.alpha, activate);
+    case Activation::GELU: return activate_tile_as<Activation::GELU>(v, act.alpha, activate);
   }
 }
 

@@ -1,6 +1,7 @@
-// The constants of the vector exp functions, shared by every ISA's math header
-// (x86/avx2_math.h, x86/avx512_math.h, arm/neon_math.h) so the three evaluate the same
-// polynomials. Coefficients are listed highest degree first, for Horner's rule.
+// The constants of the vector exp functions and of GELU's erfc, shared by the scalar
+// reference (kernels/activation.h) and every ISA's math header (x86/avx2_math.h,
+// x86/avx512_math.h, arm/neon_math.h) so all evaluate the same polynomials. Coefficients
+// are listed highest degree first, for Horner's rule.
 #pragma once
 #include <cstddef>
 
@@ -22,3 +23,28 @@ constexpr float kExp2[] = {1.540353039e-4f, 1.333355815e-3f, 9.618129108e-3f, 5.
                            2.402265070e-1f, 6.931471806e-1f, 1.0f};
 
 }  // namespace ampi::exp_poly
+
+namespace ampi::erfc_poly {
+
+// GELU's tail: h(u) = erfc(u / sqrt 2) / 2 = Phi(-u) for u = |x| >= 0, written as
+// exp(-u^2 / 2) * Q(u) with Q(u) = h(u) exp(u^2 / 2) smooth and slowly varying (it falls
+// from 1/2 like 1 / (u sqrt(2 pi))), so a polynomial fits it without a division.
+// Q is a degree-12 polynomial in t = u - kCentre, fitted on u in [0, kMaxArg] to minimise
+// the error of h itself (the fit weighs Q's error by exp(-u^2 / 2));
+// scripts/fit_gelu_erfc.py reproduces these float32 coefficients. Centring keeps every
+// term small against Q (no cancellation), so ISAs that fuse the multiply-adds differently
+// still agree within a few ulp even where h is tiny. Evaluated in float without FMA,
+// |h error| < 8e-8 (erf within 1.6e-7), most of it the float rounding near u = 0.
+// Beyond kMaxArg, Q is held at Q(kMaxArg): h there is below 1e-8 and exp(-u^2 / 2) takes
+// it to 0. Beyond kZeroArg, h < 1e-38 is taken as 0: exp's clamp at kMin would otherwise
+// hold it at about 1e-39, which the final x * h scales back up for huge x.
+constexpr float kMaxArg = 5.65f;
+constexpr float kCentre = 2.825f;
+constexpr float kZeroArg = 13.0f;
+constexpr float kQ[] = {5.854037610220075e-08f,   3.8070660934863554e-07f, 8.903546131477924e-07f,
+                        -1.3927290183346486e-06f, -4.8367005547333974e-06f, -1.5344472558354028e-05f,
+                        4.359320519142784e-05f,   -0.00014518068928737193f, 0.0006902930908836424f,
+                        -0.00274845608510077f,    0.010473871603608131f,    -0.03783039376139641f,
+                        0.12782754004001617f};
+
+}  // namespace ampi::erfc_poly

@@ -1,8 +1,9 @@
 // The plain scalar reference of every micro-kernel: the definition each SIMD variant is
 // tested against, and the fallback where no variant pays. One function per family of
 // kernels/kernel_list.def (contracts there), in channels.cpp, elementwise.cpp,
-// resample.cpp, conv_gemm.cpp and conv_depthwise.cpp. The naive direct convolution and
-// matrix product the ops are tested against are in conv_reference.h and gemm_reference.h.
+// resample.cpp, conv_gemm.cpp, conv_depthwise.cpp and transformer_rows.cpp. The naive
+// direct convolution and matrix product the ops are tested against are in
+// conv_reference.h and gemm_reference.h.
 #pragma once
 #include <cstdint>
 

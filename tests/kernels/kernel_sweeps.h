@@ -53,7 +53,8 @@ inline const std::vector<ActivationSpec>& all_activations() {
   static const std::vector<ActivationSpec> list = {
       {Activation::None},      {Activation::ReLU},           {Activation::ReLU6},
       {Activation::HardSwish}, {Activation::HardSigmoid},    {Activation::Sigmoid},
-      {Activation::LeakyReLU, 0.1f}, {Activation::ELU, 1.0f}, {Activation::Tanh}};
+      {Activation::LeakyReLU, 0.1f}, {Activation::ELU, 1.0f}, {Activation::Tanh},
+      {Activation::GELU}};
   return list;
 }
 
