@@ -224,7 +224,8 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
     if (!fs::is_regular_file(fs::path(a.images) / e.photo))
       throw std::runtime_error((fs::path(a.images) / e.photo).string() + ": photo of the ordinal set not found");
   const std::unique_ptr<DepthModel> net = load_depth_net(a);
-  const int side = a.working_size ? a.working_size : net->working_long_side();
+  if (a.working_size) set_working_size_option(*net, a.working_size);
+  const int side = 0;  // the network's working size, set above
   OrdinalScore network, gradient, constant;
   for (const OrdinalPhoto& e : set) {
     const std::string path = (fs::path(a.images) / e.photo).string();
@@ -281,7 +282,8 @@ int eval_depth(int argc, char** argv) {
   std::vector<std::string> references;
   for (const std::string& photo : photos) references.push_back(find_depth_reference(photo, a.images, a.reference));
   const std::unique_ptr<DepthModel> net = load_depth_net(a);
-  const int side = a.working_size ? a.working_size : net->working_long_side();
+  if (a.working_size) set_working_size_option(*net, a.working_size);
+  const int side = 0;  // the network's working size, set above
   DepthMetricsMean network, gradient;
   for (size_t i = 0; i < photos.size(); ++i) {
     const cv::Mat bgr = read_photo(photos[i]);
@@ -424,7 +426,8 @@ int eval_slicing(int argc, char** argv) {
   }
   std::unique_ptr<DepthModel> net;
   if (depth_maps.empty()) net = load_depth_model(depth_weights_path(a.weights, a.model));
-  const int side = a.working_size ? a.working_size : net ? net->working_long_side() : 0;
+  if (net && a.working_size) set_working_size_option(*net, a.working_size);
+  const int side = 0;  // the network's working size, set above
   SlicingEvaluator eval(a.options, slicing_filler(a.inpainter));
   std::vector<int> psnr_wins(a.options.counts.size()), ssim_wins(a.options.counts.size());
   for (size_t k = 0; k < photos.size(); ++k) {
