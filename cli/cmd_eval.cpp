@@ -187,7 +187,9 @@ const char kDepthUsage[] =
     "  --split S                 the ordinal set's photos scored: val (default), train or all\n"
     "  --model M                 a bundled depth model by name: lite (default), heavy\n"
     "  --weights FILE            a depth weight file instead\n"
-    "  --working-size N          long side the network runs at (default: the weight file's)\n"
+    "  --working-size N          the network's working size (default: the weight file's): the\n"
+    "                            long side for lite and heavy, the input's shorter side for\n"
+    "                            Depth Anything V2\n"
     "  --limit N                 only the first N photos\n"
     "  --threads N               worker threads (default: all hardware threads)\n";
 
@@ -344,7 +346,9 @@ const char kSlicingUsage[] =
     "  --amplitude A           circle radius / nearest reference depth (default 0.05)\n"
     "  --max-size N            photos are scaled down to this long side (default 512)\n"
     "  --model M, --weights F  depth network: bundled lite (default) or heavy, or a file\n"
-    "  --working-size N        long side the network runs at (default: the weight file's)\n"
+    "  --working-size N        the network's working size (default: the weight file's; the\n"
+    "                          long side for lite and heavy, the shorter side for Depth\n"
+    "                          Anything V2)\n"
     "  --depth-dir D           depth maps instead of the network: the one file D/sub/name.* for\n"
     "                          DIR/sub/name.jpg, any format ampi run --depth reads, larger = nearer\n"
     "  --inpainter I           push-pull (default) or network (weights/inpaint.ampw; ampi run's default)\n"
