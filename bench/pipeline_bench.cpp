@@ -136,11 +136,12 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
 // arena persists, and the depth stage includes shrinking the photo.
 void measure_slicing_share(const cv::Mat& source, const MpiOptions& options, int reps, SizeResult& r) {
   const std::unique_ptr<DepthModel> net = load_depth_model(depth_weights_path(options.depth_weights, options.depth_model));
-  const int side = options.working_size ? options.working_size : net->working_long_side();
+  if (options.working_size) set_working_size_option(*net, options.working_size);
   cv::Mat photo, small;
   cv::resize(source, photo, r.size, 0, 0, cv::INTER_AREA);
-  const ImageSize work = depth_working_size(photo.rows, photo.cols, side);
+  const ImageSize work = net->input_size(photo.rows, photo.cols);
   cv::resize(photo, small, {work.width, work.height}, 0, 0, cv::INTER_AREA);
+  const int side = 0;  // the size set above
   cv::Mat disparity = estimate_disparity(*net, small, side);
   std::vector<double> network_ms, slicing_ms;
   for (int k = 0; k <= reps; ++k) {  // k = 0 warms up

@@ -67,7 +67,7 @@ const char kPipelineUsage[] =
     "  --threads N    worker threads (default 2)\n"
     "  --frames N     video frames rendered and encoded per run (default 30)\n"
     "  --inpainter NAME      network (default, as ampi run), harmonic or push-pull\n"
-    "  --working-size N      the depth network's long side (default: the weight file's)\n"
+    "  --working-size N      the depth network's working size (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
 
 int bench_pipeline(int argc, char** argv) {

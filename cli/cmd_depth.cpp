@@ -32,13 +32,16 @@ const char kUsage[] =
     "                    $AMPI_WEIGHTS_DIR or weights/ beside the program): lite (default,\n"
     "                    faster) or heavy (more accurate)\n"
     "  --weights FILE    a depth weight file of any depth architecture instead\n"
-    "  --max-size N      working resolution: long side in pixels (default: what the\n"
-    "                    weight file asks for, depth.working_long_side, else 1024)\n"
+    "  --working-size N  the network's working resolution (default: the weight file's):\n"
+    "                    the long side in pixels for lite and heavy (the photo is never\n"
+    "                    scaled up), the input's shorter side for Depth Anything V2\n"
+    "                    (depth.working_size, 518; rounded to multiples of its patch)\n"
+    "  --max-size N      the same as --working-size (its older name)\n"
     "  --threads N       worker threads (default: all hardware threads)\n";
 
 struct DepthOptions {
   std::string photo, output, model = "lite", weights;
-  int max_size = 0;  // 0: the weight file's working_long_side
+  int working_size = 0;  // 0: the weight file's
   int threads = 0;
 };
 
@@ -53,7 +56,8 @@ DepthOptions parse(int argc, char** argv, bool& help) {
     o.model = v;
   });
   p.option("--weights", &o.weights);
-  p.option("--max-size", &o.max_size, 1, 16384);
+  p.option("--working-size", &o.working_size, 1, 16384);
+  p.option("--max-size", &o.working_size, 1, 16384);
   p.option("--threads", &o.threads, 1, 1024);
   p.positionals(&photos);
   help = !p.parse(argc, argv);
@@ -66,8 +70,8 @@ DepthOptions parse(int argc, char** argv, bool& help) {
 }
 
 // The network's map at the working resolution, brought back to the photo's size.
-cv::Mat disparity_at_photo_size(DepthModel& net, const cv::Mat& bgr, int max_size, ThreadPool& pool) {
-  const cv::Mat work = estimate_disparity(net, bgr, max_size, pool);
+cv::Mat disparity_at_photo_size(DepthModel& net, const cv::Mat& bgr, ThreadPool& pool) {
+  const cv::Mat work = estimate_disparity(net, bgr, 0, pool);
   if (work.size() == bgr.size()) return work;
   cv::Mat full;
   cv::resize(work, full, bgr.size(), 0, 0, cv::INTER_LINEAR);
@@ -81,16 +85,15 @@ int cmd_depth(int argc, char** argv) {
   const DepthOptions o = parse(argc, argv, help);
   if (help) return 0;
   const std::unique_ptr<DepthModel> net = load_depth_model(depth_weights_path(o.weights, o.model));
-  const int max_size = o.max_size ? o.max_size : net->working_long_side();
+  if (o.working_size) set_working_size_option(*net, o.working_size);
   const cv::Mat photo = read_photo(o.photo);
   ThreadPool pool(o.threads);
   const auto start = std::chrono::steady_clock::now();
-  const cv::Mat disparity = disparity_at_photo_size(*net, photo, max_size, pool);
+  const cv::Mat disparity = disparity_at_photo_size(*net, photo, pool);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   write_depth_png16(disparity, o.output);
-  const ImageSize work = depth_working_size(photo.rows, photo.cols, max_size);
-  std::printf("%s: %dx%d disparity (%s network at %dx%d, %.2f s) -> %s\n", o.photo.c_str(), photo.cols,
-              photo.rows, net->variant().c_str(), work.width, work.height, seconds, o.output.c_str());
+  std::printf("%s: %dx%d disparity (%s network, working size %d, %.2f s) -> %s\n", o.photo.c_str(), photo.cols,
+              photo.rows, net->variant().c_str(), net->working_size(), seconds, o.output.c_str());
   return 0;
 }
 

@@ -1,5 +1,6 @@
 // ampi distill --teacher FILE.ampw --images DIR -o LABELS: the paper's pseudo ground
 // truth, a teacher's 10x ensemble per photo, for training the bundled networks.
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -17,6 +18,7 @@
 #include "distill/ensemble.h"
 #include "distill/label_folder.h"
 #include "nets/model_loader.h"
+#include "pipeline/depth_estimate.h"
 #include "pipeline/photo_io.h"
 
 namespace ampi::cli {
@@ -112,10 +114,12 @@ std::vector<std::string> relative_photos(const std::string& images) {
   return photos;
 }
 
-// The teacher as the ensemble calls it: the model run at the image's own size.
+// The teacher as the ensemble calls it: the model run at the image's own size (each
+// square of the ensemble at its own resolution, whatever the file's working size).
 Teacher teacher_of(DepthModel& net, ThreadPool& pool) {
   return [&net, &pool](const cv::Mat& rgb) {
     const cv::Mat input = rgb.isContinuous() ? rgb : rgb.clone();
+    net.set_working_size(std::max(input.rows, input.cols));
     const Tensor d = net.run(input.ptr<float>(), input.rows, input.cols, pool);
     return cv::Mat(input.rows, input.cols, CV_32FC1, const_cast<float*>(d.f32())).clone();
   };
@@ -140,6 +144,7 @@ int cmd_distill(int argc, char** argv) {
   if (help) return 0;
   const std::vector<std::string> photos = relative_photos(o.images);
   const std::unique_ptr<DepthModel> net = load_depth_model(o.teacher);
+  for (int side : o.resolutions) set_working_size_option(*net, side, "--resolutions");  // before any photo
   const LabelRecipe recipe{fs::path(o.teacher).filename().string(), net->architecture(), net->variant(),
                            o.resolutions, fs::absolute(o.images).lexically_normal().string()};
   LabelFolder labels(o.labels, recipe);

@@ -187,7 +187,9 @@ const char kDepthUsage[] =
     "  --split S                 the ordinal set's photos scored: val (default), train or all\n"
     "  --model M                 a bundled depth model by name: lite (default), heavy\n"
     "  --weights FILE            a depth weight file instead\n"
-    "  --working-size N          long side the network runs at (default: the weight file's)\n"
+    "  --working-size N          the network's working size (default: the weight file's): the\n"
+    "                            long side for lite and heavy, the input's shorter side for\n"
+    "                            Depth Anything V2\n"
     "  --limit N                 only the first N photos\n"
     "  --threads N               worker threads (default: all hardware threads)\n";
 
@@ -224,7 +226,8 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
     if (!fs::is_regular_file(fs::path(a.images) / e.photo))
       throw std::runtime_error((fs::path(a.images) / e.photo).string() + ": photo of the ordinal set not found");
   const std::unique_ptr<DepthModel> net = load_depth_net(a);
-  const int side = a.working_size ? a.working_size : net->working_long_side();
+  if (a.working_size) set_working_size_option(*net, a.working_size);
+  const int side = 0;  // the network's working size, set above
   OrdinalScore network, gradient, constant;
   for (const OrdinalPhoto& e : set) {
     const std::string path = (fs::path(a.images) / e.photo).string();
@@ -281,7 +284,8 @@ int eval_depth(int argc, char** argv) {
   std::vector<std::string> references;
   for (const std::string& photo : photos) references.push_back(find_depth_reference(photo, a.images, a.reference));
   const std::unique_ptr<DepthModel> net = load_depth_net(a);
-  const int side = a.working_size ? a.working_size : net->working_long_side();
+  if (a.working_size) set_working_size_option(*net, a.working_size);
+  const int side = 0;  // the network's working size, set above
   DepthMetricsMean network, gradient;
   for (size_t i = 0; i < photos.size(); ++i) {
     const cv::Mat bgr = read_photo(photos[i]);
@@ -342,7 +346,9 @@ const char kSlicingUsage[] =
     "  --amplitude A           circle radius / nearest reference depth (default 0.05)\n"
     "  --max-size N            photos are scaled down to this long side (default 512)\n"
     "  --model M, --weights F  depth network: bundled lite (default) or heavy, or a file\n"
-    "  --working-size N        long side the network runs at (default: the weight file's)\n"
+    "  --working-size N        the network's working size (default: the weight file's; the\n"
+    "                          long side for lite and heavy, the shorter side for Depth\n"
+    "                          Anything V2)\n"
     "  --depth-dir D           depth maps instead of the network: the one file D/sub/name.* for\n"
     "                          DIR/sub/name.jpg, any format ampi run --depth reads, larger = nearer\n"
     "  --inpainter I           push-pull (default) or network (weights/inpaint.ampw; ampi run's default)\n"
@@ -424,7 +430,8 @@ int eval_slicing(int argc, char** argv) {
   }
   std::unique_ptr<DepthModel> net;
   if (depth_maps.empty()) net = load_depth_model(depth_weights_path(a.weights, a.model));
-  const int side = a.working_size ? a.working_size : net ? net->working_long_side() : 0;
+  if (net && a.working_size) set_working_size_option(*net, a.working_size);
+  const int side = 0;  // the network's working size, set above
   SlicingEvaluator eval(a.options, slicing_filler(a.inpainter));
   std::vector<int> psnr_wins(a.options.counts.size()), ssim_wins(a.options.counts.size());
   for (size_t k = 0; k < photos.size(); ++k) {

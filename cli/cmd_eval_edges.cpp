@@ -205,7 +205,7 @@ int eval_photos(const EdgeEvalArgs& a) {
   const Pose pose = pose_of(a.poses[0]);
   for (size_t i = 0; i < photos.size(); ++i) {
     const cv::Mat bgr = fit_long_side(read_photo(photos[i]), a.max_size);
-    cv::Mat disparity = net ? estimate_disparity(*net, bgr, net->working_long_side()) : read_depth_map(maps[i], false);
+    cv::Mat disparity = net ? estimate_disparity(*net, bgr, 0) : read_depth_map(maps[i], false);
     if (disparity.cols > bgr.cols || disparity.rows > bgr.rows)
       cv::resize(disparity, disparity, bgr.size(), 0, 0, cv::INTER_AREA);
     const MpiResult before = make_mpi(a, bgr, disparity, false);

@@ -9,6 +9,7 @@
 
 #include "cli/args.h"
 #include "cli/commands.h"
+#include "nets/model_loader.h"
 #include "weights_format/weight_file.h"
 
 namespace ampi::cli {
@@ -18,7 +19,9 @@ const char kUsage[] =
     "usage: ampi info FILE.ampw\n"
     "\n"
     "Validates a weight file (checksums, bounds, shapes) and prints its format version,\n"
-    "metadata, tensor table (name, dtype, shape, bytes) and totals.\n";
+    "metadata, tensor table (name, dtype, shape, bytes) and totals. A depth network's file\n"
+    "is also built, and its architecture, variant, parameters (those inference runs) and\n"
+    "working size are printed first.\n";
 
 template <size_t N>
 void print_table(const std::array<std::string, N>& header, const std::vector<std::array<std::string, N>>& rows) {
@@ -39,8 +42,24 @@ void print_table(const std::array<std::string, N>& header, const std::vector<std
   for (const auto& row : rows) print_row(row);
 }
 
+// The network a depth file builds, in one line; nothing for other files. A file whose
+// network cannot be built is still shown, with the reason.
+void print_model(const WeightFile& wf) {
+  std::unique_ptr<DepthModel> net;
+  try {
+    if (!wf.has("arch") || model_kind(wf) != ModelKind::Depth) return;
+    net = load_depth_model(wf);
+  } catch (const std::exception& e) {
+    std::printf("model: cannot be built: %s\n", e.what());
+    return;
+  }
+  std::printf("model: %s, variant %s, %lld parameters, working size %d\n", net->architecture().c_str(),
+              net->variant().c_str(), static_cast<long long>(net->parameter_count()), net->working_size());
+}
+
 void print_info(const WeightFile& wf) {
   std::printf("%s: AMPW version %d.%d\n", wf.path().c_str(), wf.version_major(), wf.version_minor());
+  print_model(wf);
 
   const auto metadata = wf.metadata_rows();
   std::printf("\nmetadata (%zu entries):\n", metadata.size());

@@ -29,8 +29,17 @@ class DepthModel {
 
   virtual const std::string& architecture() const = 0;  // the file's `arch`
   virtual const std::string& variant() const = 0;       // "lite", "heavy", ... as the file names it
-  // The long side the weights work best at: the default working resolution.
-  virtual int working_long_side() const = 0;
+  // The working resolution run() computes at, the file's by default: the photo's long
+  // side for the wavelet networks (lite, heavy; their callers resize to it), the
+  // network input's shorter side for Depth Anything V2 (it resizes inside).
+  virtual int working_size() const = 0;
+  // Throws std::invalid_argument ("working size N is not in A..B") for a size the
+  // network cannot run at.
+  virtual void set_working_size(int size) = 0;
+  // The size a caller resizes a height x width photo to before run(): the wavelet
+  // networks' working resolution (depth_working_size), the photo itself for a network
+  // that does its own resizing.
+  virtual ImageSize input_size(int height, int width) const = 0;
   virtual int64_t parameter_count() const = 0;  // weights and biases the inference graph uses
   // Bytes of the activation arena of the last run (0 before the first).
   virtual size_t arena_bytes() const = 0;

@@ -19,6 +19,7 @@ constexpr int64_t kFormatVersion = 1;
 constexpr int kFieldsPerBlock = 6;  // kind, out, expanded, kernel, se_reduced, activation
 constexpr int kMaxLevels = 8;
 constexpr int kDefaultWorkingLongSide = 1024;
+constexpr int kMaxWorkingSize = 16384;
 
 enum class BlockKind { Conv = 0, MobileNetV3 = 1 };
 
@@ -208,7 +209,7 @@ DepthNet DepthNet::from_file(const WeightFile& f, const KernelTable& table) {
     fail(f, "depth.multiple disagrees with 2^depth.levels");
   if (f.has("depth.working_long_side")) {
     const int64_t side = f.get_int("depth.working_long_side");
-    if (side < impl->multiple() || side > 16384)
+    if (side < impl->multiple() || side > kMaxWorkingSize)
       fail(f, "depth.working_long_side " + std::to_string(side) + " is not in " +
                   std::to_string(impl->multiple()) + "..16384");
     impl->working_long_side = int(side);
@@ -391,7 +392,16 @@ const std::string& DepthNet::architecture() const {
 }
 const std::string& DepthNet::variant() const { return impl_->variant; }
 int DepthNet::multiple() const { return impl_->multiple(); }
-int DepthNet::working_long_side() const { return impl_->working_long_side; }
+int DepthNet::working_size() const { return impl_->working_long_side; }
+void DepthNet::set_working_size(int size) {
+  if (size < 1 || size > kMaxWorkingSize)  // any size: run() pads to the multiple
+    throw std::invalid_argument("working size " + std::to_string(size) + " is not in 1.." +
+                                std::to_string(kMaxWorkingSize));
+  impl_->working_long_side = size;
+}
+ImageSize DepthNet::input_size(int height, int width) const {
+  return depth_working_size(height, width, impl_->working_long_side);
+}
 int64_t DepthNet::parameter_count() const { return impl_->params; }
 size_t DepthNet::arena_bytes() const { return impl_->plan ? impl_->plan->arena_bytes() : 0; }
 

@@ -43,9 +43,12 @@ class DepthNet final : public DepthModel {
   const std::string& architecture() const override;
   const std::string& variant() const override;
   int multiple() const;  // the padding granularity (2^levels)
-  // Metadata depth.working_long_side (weights trained on small images ask for a smaller
-  // working resolution); 1024 when absent.
-  int working_long_side() const override;
+  // The long side photos are resized to: metadata depth.working_long_side (weights
+  // trained on small images ask for a smaller working resolution), 1024 when absent;
+  // set_working_size takes 1..16384 (run() pads to the multiple).
+  int working_size() const override;
+  void set_working_size(int size) override;
+  ImageSize input_size(int height, int width) const override;
   int64_t parameter_count() const override;
   size_t arena_bytes() const override;
 

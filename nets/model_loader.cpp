@@ -3,6 +3,7 @@
 #include <stdexcept>
 
 #include "nets/architectures.h"
+#include "nets/depth_anything_net.h"
 #include "nets/depth_net.h"
 
 namespace ampi {
@@ -17,6 +18,7 @@ struct Architecture {
 // case in the loader of its kind.
 constexpr Architecture kArchitectures[] = {
     {arch::kDepthDwtMobileNetV3, ModelKind::Depth},
+    {arch::kDepthDinoV2Dpt, ModelKind::Depth},
     {arch::kInpaintGatedConv, ModelKind::Inpaint},
 };
 
@@ -55,6 +57,8 @@ std::string model_name(const WeightFile& file) {
 
 std::unique_ptr<DepthModel> load_depth_model(const WeightFile& file, const KernelTable& table) {
   require_kind(file, ModelKind::Depth);
+  if (file.get_string("arch") == arch::kDepthDinoV2Dpt)
+    return std::make_unique<DepthAnythingNet>(DepthAnythingNet::from_file(file, table));
   return std::make_unique<DepthNet>(DepthNet::from_file(file, table));
 }
 

@@ -50,8 +50,8 @@ cv::Mat MpiMaker::working_disparity(const cv::Mat& bgr, cv::Size photo_size, con
     depth_net_ = progress.stage("load depth", [&] { return load_depth_model(path); });
   }
   return progress.stage("depth", [&] {
-    const int side = options_.working_size ? options_.working_size : depth_net_->working_long_side();
-    return estimate_disparity(*depth_net_, bgr, side);
+    if (options_.working_size) set_working_size_option(*depth_net_, options_.working_size);
+    return estimate_disparity(*depth_net_, bgr, 0);
   });
 }
 

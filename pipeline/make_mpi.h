@@ -20,8 +20,9 @@ struct MpiOptions {
   std::string depth_weights;         // a weight file instead of the bundled one
   std::string depth_file;            // the user's own depth map instead of the network
   bool depth_is_distance = false;    // depth_file holds distances (larger = farther)
-  // Long side the depth network runs at; 0: what the weight file asks for
-  // (depth.working_long_side). The slicer runs at this size too, at most 1024.
+  // The depth network's working size (DepthModel::set_working_size: the long side for
+  // lite and heavy, the input's shorter side for Depth Anything V2); 0: the weight
+  // file's. The slicer runs at this size too (as a long side), at most 1024.
   int working_size = 0;
   bool uniform = false;              // the paper's baseline instead of adaptive slicing
   SlicingParams slicing;             // max_planes, the paper's constants, depth range

@@ -80,8 +80,8 @@ TEST_CASE("depth net metadata: parameter counts and multiple") {
   CHECK(lite.multiple() == 32);
   CHECK(heavy.multiple() == 32);
   // A file may ask for a working resolution (weights trained on small images do).
-  CHECK(lite.working_long_side() >= lite.multiple());
-  CHECK(heavy.working_long_side() >= heavy.multiple());
+  CHECK(lite.working_size() >= lite.multiple());
+  CHECK(heavy.working_size() >= heavy.multiple());
   // The inference graph: the folded count of training/depth_model.py minus the three
   // coarse heads, which are trained but not run (nets/ARCHITECTURE.md).
   CHECK(lite.parameter_count() == 2'656'800 - 1156 - 2308 - 4036);

@@ -58,7 +58,7 @@ TEST_CASE("model loader: a depth file builds the depth network its arch names, o
     const std::unique_ptr<DepthModel> net = load_depth_model(kNets + "tiny_depth.ampw", kernels_for(isa));
     CHECK(net->architecture() == "ampi.depth.dwt-mobilenetv3");
     CHECK(net->variant() == "tiny");
-    CHECK(net->working_long_side() == 64);
+    CHECK(net->working_size() == 64);
     const Tensor out = net->run(rgb.data(), 40, 50, pool);
     REQUIRE(out.shape() == Shape{40, 50});
     if (first.empty()) first.assign(out.f32(), out.f32() + out.numel());
@@ -84,7 +84,7 @@ TEST_CASE("model loader: every broken promise of a depth file is one line naming
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"no_arch", "no 'arch' metadata: not a network weight file"},
       {"unknown_arch", "unknown architecture 'ampi.depth.vit-huge' (this build runs ampi.depth.dwt-mobilenetv3, "
-                       "ampi.inpaint.gated-conv)"},
+                       "ampi.depth.dav2-vit-dpt, ampi.inpaint.gated-conv)"},
       {"version", "depth.format_version 2 is not supported"},
       {"levels", "depth.levels 9 is not in 2..8"},
       {"multiple", "depth.multiple disagrees with 2^depth.levels"},

@@ -1,0 +1,269 @@
+#include "kernels/transformer_ops.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace ampi {
+namespace {
+
+[[noreturn]] void fail(const std::string& what) { throw std::runtime_error(what); }
+
+// Queries per attention task and keys per streamed block: a task's scores (64 x 256
+// floats, 64 KiB) stay in L2 between the two products, and 64 rows fill whole GEMM tiles.
+constexpr int kQueryBlock = 64;
+constexpr int kKeyBlock = 256;
+
+// PyTorch's cubic convolution kernel, a = -0.75: `near` for |t| <= 1, `far` for 1 < |t| < 2.
+double cubic_near(double t, double a) { return ((a + 2) * t - (a + 3)) * t * t + 1; }
+double cubic_far(double t, double a) { return ((a * t - 5 * a) * t + 8 * a) * t - 4 * a; }
+
+// out[x] = sum_tap weight[x][tap] * row[index[x][tap]], c channels per pixel.
+void cubic_row(const float* row, int c, const CubicAxis& ax, int out_w, float* out) {
+  for (int x = 0; x < out_w; ++x) {
+    const int32_t* i = &ax.index[size_t(x) * 4];
+    const float* wt = &ax.weight[size_t(x) * 4];
+    for (int ch = 0; ch < c; ++ch)
+      out[size_t(x) * c + ch] = row[size_t(i[0]) * c + ch] * wt[0] + row[size_t(i[1]) * c + ch] * wt[1] +
+                                row[size_t(i[2]) * c + ch] * wt[2] + row[size_t(i[3]) * c + ch] * wt[3];
+  }
+}
+
+// Source positions of align_corners=True in single precision, as PyTorch computes them
+// for float maps: position = x * (in - 1) / (out - 1).
+struct LinearAxis {
+  std::vector<int32_t> lo, hi;
+  std::vector<float> weight;
+};
+
+LinearAxis linear_corners_axis(int n_out, int n_in) {
+  LinearAxis ax;
+  ax.lo.resize(n_out);
+  ax.hi.resize(n_out);
+  ax.weight.resize(n_out);
+  const float step = n_out > 1 ? float(n_in - 1) / float(n_out - 1) : 0.0f;
+  for (int i = 0; i < n_out; ++i) {
+    const float src = step * float(i);
+    const int lo = std::min(int(src), n_in - 1);
+    ax.lo[i] = lo;
+    ax.hi[i] = lo < n_in - 1 ? lo + 1 : lo;
+    ax.weight[i] = src - float(lo);
+  }
+  return ax;
+}
+
+void require_positive(const char* op, std::initializer_list<int> sizes) {
+  for (int s : sizes)
+    if (s <= 0) fail(std::string(op) + ": sizes must be positive");
+}
+
+}  // namespace
+
+// ---- resampling -----------------------------------------------------------------------
+
+CubicAxis cubic_axis(int n_out, int n_in, double src_per_dst) {
+  constexpr double a = -0.75;
+  CubicAxis ax;
+  ax.index.resize(size_t(n_out) * 4);
+  ax.weight.resize(size_t(n_out) * 4);
+  for (int i = 0; i < n_out; ++i) {
+    const double src = (i + 0.5) * src_per_dst - 0.5;
+    const double base = std::floor(src), t = src - base;
+    const double w[4] = {cubic_far(t + 1, a), cubic_near(t, a), cubic_near(1 - t, a), cubic_far(2 - t, a)};
+    for (int tap = 0; tap < 4; ++tap) {
+      ax.index[size_t(i) * 4 + tap] = int32_t(std::clamp<double>(base - 1 + tap, 0, n_in - 1));
+      ax.weight[size_t(i) * 4 + tap] = float(w[tap]);
+    }
+  }
+  return ax;
+}
+
+void resize_bicubic(const float* in, int h, int w, int c, int out_h, int out_w, double src_per_dst_y,
+                    double src_per_dst_x, float* out, ThreadPool& pool) {
+  require_positive("resize_bicubic", {h, w, c, out_h, out_w});
+  const CubicAxis ay = cubic_axis(out_h, h, src_per_dst_y), ax = cubic_axis(out_w, w, src_per_dst_x);
+  const size_t row_floats = size_t(out_w) * c;
+  // Each output row: the four input rows it reads resized across first, then blended, in
+  // PyTorch's order (horizontal taps, then vertical).
+  pool.parallel_for(out_h, 4, [&](int64_t y0, int64_t y1) {
+    std::vector<float> across(4 * row_floats);
+    for (int64_t y = y0; y < y1; ++y) {
+      for (int tap = 0; tap < 4; ++tap)
+        cubic_row(in + size_t(ay.index[y * 4 + tap]) * w * c, c, ax, out_w, &across[tap * row_floats]);
+      const float* wt = &ay.weight[y * 4];
+      float* dst = out + size_t(y) * row_floats;
+      for (size_t i = 0; i < row_floats; ++i)
+        dst[i] = across[i] * wt[0] + across[row_floats + i] * wt[1] + across[2 * row_floats + i] * wt[2] +
+                 across[3 * row_floats + i] * wt[3];
+    }
+  });
+}
+
+void resize_bilinear_corners(const float* in, int h, int w, int c, int out_h, int out_w, float* out,
+                             ThreadPool& pool, const KernelTable& k) {
+  require_positive("resize_bilinear_corners", {h, w, c, out_h, out_w});
+  const LinearAxis ay = linear_corners_axis(out_h, h), ax = linear_corners_axis(out_w, w);
+  pool.parallel_for(out_h, 4, [&](int64_t y0, int64_t y1) {
+    for (int64_t y = y0; y < y1; ++y)
+      k.bilinear_row(in + size_t(ay.lo[y]) * w * c, in + size_t(ay.hi[y]) * w * c, ay.weight[y], ax.lo.data(),
+                     ax.hi.data(), ax.weight.data(), out_w, c, out + size_t(y) * out_w * c);
+  });
+}
+
+std::vector<float> interpolate_pos_embed(const float* pos, int grid, int dim, int rows, int cols, double offset) {
+  require_positive("interpolate_pos_embed", {grid, dim, rows, cols});
+  const size_t cells = size_t(rows) * cols;
+  std::vector<float> out((1 + cells) * dim);
+  std::copy(pos, pos + dim, out.begin());  // the class token's entry
+  if (rows == grid && cols == grid) {
+    std::copy(pos + dim, pos + size_t(1 + cells) * dim, out.begin() + dim);
+    return out;
+  }
+  // The sample step is 1 / scale factor, with the offset in the factor.
+  ThreadPool serial(1);
+  resize_bicubic(pos + dim, grid, grid, dim, rows, cols, grid / (rows + offset), grid / (cols + offset),
+                 out.data() + dim, serial);
+  return out;
+}
+
+// ---- token ops --------------------------------------------------------------------------
+
+void layer_norm(const float* in, int64_t in_stride, int64_t tokens, int c, const float* gamma,
+                const float* beta, float eps, float* out, int64_t out_stride, ThreadPool& pool,
+                const KernelTable& k) {
+  if (tokens <= 0 || c <= 0 || in_stride < c || out_stride < c) fail("layer_norm: bad sizes or strides");
+  pool.parallel_for(tokens, 16, [&](int64_t t0, int64_t t1) {
+    for (int64_t t = t0; t < t1; ++t) k.layer_norm_row(in + t * in_stride, c, gamma, beta, eps, out + t * out_stride);
+  });
+}
+
+PatchEmbedding::PatchEmbedding(int patch, int dim, const float* weights, const float* bias, const KernelTable& k)
+    : patch_(patch), weights_(weights, bias, dim, patch * patch * 3, k) {
+  require_positive("PatchEmbedding", {patch, dim});
+}
+
+void PatchEmbedding::run(const float* image, int h, int w, float* out, int64_t out_stride,
+                         const float* residual, ThreadPool& pool) const {
+  if (patch_ <= 0) fail("PatchEmbedding::run: empty op");
+  if (h <= 0 || w <= 0 || h % patch_ || w % patch_)
+    fail("PatchEmbedding::run: image " + std::to_string(h) + "x" + std::to_string(w) +
+         " is not a multiple of the patch size " + std::to_string(patch_));
+  const int rows = h / patch_, cols = w / patch_, k = weights_.k();
+  const int64_t tokens = int64_t(rows) * cols;
+  // im2col: each patch's pixels in the weights' [ky][kx][channel] order, one row per token.
+  std::vector<float> patches(size_t(tokens) * k);
+  const int run = patch_ * 3;  // one patch row: contiguous in the image
+  pool.parallel_for(rows, 1, [&](int64_t r0, int64_t r1) {
+    for (int64_t r = r0; r < r1; ++r)
+      for (int col = 0; col < cols; ++col)
+        for (int ky = 0; ky < patch_; ++ky) {
+          const float* src = image + ((r * patch_ + ky) * size_t(w) + size_t(col) * patch_) * 3;
+          std::copy(src, src + run, &patches[(size_t(r) * cols + col) * k + size_t(ky) * run]);
+        }
+  });
+  GemmProblem p;
+  p.m = int(tokens);
+  p.n = weights_.n();
+  p.k = k;
+  p.a = patches.data();
+  p.a_stride = k;
+  p.c = out;
+  p.c_stride = out_stride;
+  p.residual = residual;
+  gemm(p, weights_, pool);
+}
+
+void self_attention(const float* qkv, int tokens, int dim, int heads, float scale, float* out,
+                    int64_t out_stride, ThreadPool& pool, const KernelTable& k) {
+  if (tokens <= 0 || heads <= 0 || dim <= 0 || dim % heads || out_stride < dim)
+    fail("self_attention: bad sizes (dim must split into the heads)");
+  const int head_dim = dim / heads;
+  const int64_t row = 3 * int64_t(dim);
+  const int query_blocks = (tokens + kQueryBlock - 1) / kQueryBlock;
+  // One task per head and block of queries; its products run on the calling thread (a
+  // nested loop of the pool runs inline), so the split never depends on the thread count.
+  pool.parallel_for(int64_t(heads) * query_blocks, 1, [&](int64_t u0, int64_t u1) {
+    std::vector<float> scores(size_t(kQueryBlock) * kKeyBlock);
+    float running_max[kQueryBlock], running_sum[kQueryBlock];
+    for (int64_t u = u0; u < u1; ++u) {
+      const int head = int(u / query_blocks), q0 = int(u % query_blocks) * kQueryBlock;
+      const int qn = std::min(kQueryBlock, tokens - q0);
+      const float* q = qkv + q0 * row + head * head_dim;
+      float* o = out + q0 * out_stride + head * head_dim;
+      std::fill(running_max, running_max + qn, -INFINITY);
+      std::fill(running_sum, running_sum + qn, 0.0f);
+      for (int k0 = 0; k0 < tokens; k0 += kKeyBlock) {
+        const int kn = std::min(kKeyBlock, tokens - k0);
+        GemmProblem s;  // scores = Q K^T of this block of keys
+        s.m = qn;
+        s.n = kn;
+        s.k = head_dim;
+        s.a = q;
+        s.a_stride = row;
+        s.c = scores.data();
+        s.c_stride = kKeyBlock;
+        gemm(s, StridedMatrix{qkv + k0 * row + dim + head * head_dim, row, true}, nullptr, pool, k);
+        for (int r = 0; r < qn; ++r) {
+          const float factor =
+              k.softmax_block_row(&scores[size_t(r) * kKeyBlock], kn, scale, &running_max[r], &running_sum[r]);
+          if (k0 > 0)
+            for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= factor;
+        }
+        GemmProblem pv;  // out += P V of this block (the first block writes out)
+        pv.m = qn;
+        pv.n = head_dim;
+        pv.k = kn;
+        pv.a = scores.data();
+        pv.a_stride = kKeyBlock;
+        pv.c = o;
+        pv.c_stride = out_stride;
+        pv.residual = k0 > 0 ? o : nullptr;
+        gemm(pv, StridedMatrix{qkv + k0 * row + 2 * dim + head * head_dim, row, false}, nullptr, pool, k);
+      }
+      for (int r = 0; r < qn; ++r) {
+        const float inv = 1.0f / running_sum[r];
+        for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= inv;
+      }
+    }
+  });
+}
+
+// ---- transposed convolution -------------------------------------------------------------
+
+StridedTransposedConv::StridedTransposedConv(int stride, int in_c, int out_c, const float* weights,
+                                             const float* bias, const KernelTable& k)
+    : stride_(stride), in_c_(in_c), out_c_(out_c) {
+  require_positive("StridedTransposedConv", {stride, in_c, out_c});
+  if (!weights) fail("StridedTransposedConv: no weights");
+  // Each kernel row's GEMM has stride * out_c columns (kx, then o), each with o's bias.
+  std::vector<float> row_bias(size_t(stride) * out_c, 0.0f);
+  for (int kx = 0; kx < stride; ++kx)
+    for (int o = 0; o < out_c; ++o) row_bias[size_t(kx) * out_c + o] = bias ? bias[o] : 0.0f;
+  const size_t row_floats = size_t(stride) * out_c * in_c;
+  for (int ky = 0; ky < stride; ++ky)
+    rows_.emplace_back(weights + ky * row_floats, row_bias.data(), stride * out_c, in_c, k);
+}
+
+void StridedTransposedConv::run(const float* in, int h, int w, float* out, ThreadPool& pool) const {
+  if (stride_ <= 0) fail("StridedTransposedConv::run: empty op");
+  require_positive("StridedTransposedConv::run", {h, w});
+  const int64_t block = int64_t(stride_) * out_c_;  // the outputs of one input pixel in one output row
+  const int64_t out_row = int64_t(w) * block;
+  pool.parallel_for(h, 1, [&](int64_t y0, int64_t y1) {
+    for (int64_t y = y0; y < y1; ++y)
+      for (int ky = 0; ky < stride_; ++ky) {
+        GemmProblem p;
+        p.m = w;
+        p.n = int(block);
+        p.k = in_c_;
+        p.a = in + y * w * in_c_;
+        p.a_stride = in_c_;
+        p.c = out + (y * stride_ + ky) * out_row;
+        p.c_stride = block;
+        gemm(p, rows_[ky], pool);
+      }
+  });
+}
+
+}  // namespace ampi
