@@ -3,10 +3,10 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
-#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 
 #include <cstdio>
@@ -75,17 +75,35 @@ std::vector<char*> argv_of(const std::vector<std::string>& args) {
   return argv;
 }
 
-// The exit status of a finished child (-1 if it did not exit by itself); its peak
-// resident memory in MB into peak_mb when given.
-int wait_for(pid_t pid, double* peak_mb = nullptr) {
+// The exit status of a finished child (-1 if it did not exit by itself).
+int wait_for(pid_t pid) {
   int status = 0;
-  struct rusage usage {};
   pid_t waited;
-  do waited = ::wait4(pid, &status, 0, &usage);
+  do waited = ::waitpid(pid, &status, 0);
   while (waited < 0 && errno == EINTR);
   if (waited < 0) return -1;
-  if (peak_mb) *peak_mb = usage.ru_maxrss / 1024.0;  // Linux reports kB
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Whether the child has exited (it stays a zombie until wait_for reaps it).
+bool has_exited(pid_t pid) {
+  siginfo_t info{};
+  const int result = ::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT);
+  return result != 0 || info.si_pid == pid;  // an error: nothing left to wait for
+}
+
+// A running process's peak resident memory in MB (VmHWM), 0 where /proc cannot tell.
+// Not the rusage of the reaped child: a child started by vfork and exec inherits its
+// parent's peak there (Linux keeps the replaced memory map's high-water mark).
+double peak_resident_mb(pid_t pid) {
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/status").c_str(), "r");
+  if (!f) return 0;
+  char line[256];
+  long kb = 0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "VmHWM: %ld", &kb) == 1) break;
+  std::fclose(f);
+  return kb / 1024.0;
 }
 
 int run_program(const std::vector<std::string>& args) {
@@ -232,13 +250,21 @@ void FrameWriter::send_to_encoder(const cv::Mat& bgr) {
     for (int y = 0; y < bgr.rows && sent; ++y)
       sent = write_all(encoder_input_, bgr.ptr<uint8_t>(y), bgr.cols * bgr.elemSize());
   if (!sent) fail(path_, "the ffmpeg program stopped while encoding the video");
+  // x264 holds its most frames once its lookahead is full; flushing at the end adds none.
+  encoder_peak_mb_ = std::max(encoder_peak_mb_, peak_resident_mb(encoder_pid_));
 }
 
 void FrameWriter::finish_encoder() {
   if (encoder_pid_ < 0) return;
   ::close(encoder_input_);  // end of input: ffmpeg flushes x264 and writes the MP4's index
   encoder_input_ = -1;
-  const int status = wait_for(encoder_pid_, &encoder_peak_mb_);
+  // Frames sit in the pipe and in x264's lookahead when the last one is handed over, so
+  // the peak is followed until the encoder exits.
+  while (!has_exited(encoder_pid_)) {
+    encoder_peak_mb_ = std::max(encoder_peak_mb_, peak_resident_mb(encoder_pid_));
+    ::usleep(5000);
+  }
+  const int status = wait_for(encoder_pid_);
   encoder_pid_ = -1;
   if (status != 0) fail(path_, "ffmpeg could not encode the video (exit status " + std::to_string(status) + ")");
 }

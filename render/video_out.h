@@ -49,8 +49,8 @@ class FrameWriter {
   void finish();
 
   int frames() const { return frames_; }
-  // The peak resident memory (MB) of the ffmpeg process that encoded the MP4, known
-  // after finish(); 0 when OpenCV encoded it (its memory is this process's own).
+  // The peak resident memory (MB) of the ffmpeg process encoding the MP4, as of the
+  // last frame given to it; 0 when OpenCV encodes it (its memory is this process's own).
   double encoder_peak_mb() const { return encoder_peak_mb_; }
   // A remark for the user about how the output was made (empty if nothing to say).
   const std::string& note() const { return note_; }
