@@ -37,6 +37,9 @@ struct SizeResult {
   std::map<std::string, std::vector<double>> ms;  // per stage, one value per run
   std::map<std::string, double> stage_peak_mb;    // per stage, the largest over all runs
   double peak_mb = 0;                             // the largest of any stage
+  // The ffmpeg process that encodes the MP4 (render/video_out.h), the largest over all
+  // runs; 0 when OpenCV encodes it inside this process.
+  double encoder_peak_mb = 0;
   size_t planes = 0;
   cv::Size slicing_size;  // where the depth network's output was sliced
   // The network alone and the slicer, timed alternately and warm (measure_slicing_share).
@@ -70,6 +73,7 @@ double time_to_mpi(MpiMaker& maker, const std::string& photo_file) {
 struct RunOutcome {
   size_t planes = 0;
   cv::Size slicing_size;
+  double encoder_peak_mb = 0;
 };
 
 // One `ampi run` worth of work on `photo_file`, timed by stage into `progress`, letting
@@ -79,15 +83,16 @@ RunOutcome run_once(MpiMaker& maker, const std::string& photo_file, const fs::pa
   cv::Mat bgr = progress.stage("decode", [&] { return read_photo(photo_file); });
   MpiResult result = maker.make(bgr, photo_file, progress);
   bgr.release();
-  const RunOutcome outcome{result.mpi.planes.size(), result.slicing_size};
+  RunOutcome outcome{result.mpi.planes.size(), result.slicing_size};
   fs::remove_all(scratch / "mpi");
   fs::remove_all(scratch / "video.mp4");
   progress.stage("write mpi", [&] { write_mpi_at_photo_size(result, (scratch / "mpi").string()); });
   result.disparity.release();
   result.full_bgr.release();
-  progress.stage("render+encode", [&] {
+  const VideoWritten written = progress.stage("render+encode", [&] {
     return write_video(std::move(result.mpi), video, (scratch / "video.mp4").string(), false);
   });
+  outcome.encoder_peak_mb = written.encoder_peak_mb;
   release_free_memory();
   return outcome;
 }
@@ -111,6 +116,7 @@ SizeResult measure(const cv::Mat& source, cv::Size size, int runs, const MpiOpti
     const RunOutcome outcome = run_once(maker, photo_file, scratch, video, progress);
     r.planes = outcome.planes;
     r.slicing_size = outcome.slicing_size;
+    r.encoder_peak_mb = std::max(r.encoder_peak_mb, outcome.encoder_peak_mb);
     // Memory counts every run, the one that loads the networks included.
     for (const auto& [stage, mb] : progress.peaks_mb()) {
       r.stage_peak_mb[stage] = std::max(r.stage_peak_mb[stage], mb);
@@ -183,7 +189,9 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
      << "while the stage ran (its peak is reset as each stage starts), the largest over all runs,\n"
      << "the warm-up that loads the networks included. As in `ampi run`, the heap's free\n"
      << "memory is handed back to the system after each photo and after any stage that leaves\n"
-     << "64 MB or more free (pipeline/progress.h), outside the stage times. Inpainting: "
+     << "64 MB or more free (pipeline/progress.h), outside the stage times. The MP4 is encoded\n"
+     << "by the ffmpeg program when it is installed (render/video_out.h), in a process of its\n"
+     << "own: its peak, measured when it exits, has its own row. Inpainting: "
      << inpainter_name(options.inpainter) << "; depth network's long side: "
      << (options.working_size ? std::to_string(options.working_size) : std::string("the weight file's"))
      << ". Machine: " << sysconf(_SC_NPROCESSORS_ONLN) << " cores.\n\n"
@@ -220,6 +228,13 @@ std::string table(const std::vector<SizeResult>& results, const MpiOptions& opti
   }
   md << "\n| **whole run** (peak of any stage) |";
   for (const SizeResult& r : results) md << " |" << cell(" **%.0f** |", r.peak_mb);
+  md << "\n| video encoder, its own process (ffmpeg) |";
+  for (const SizeResult& r : results) md << " |" << cell(" %.0f |", r.encoder_peak_mb);
+  md << "\n| **whole run with the encoder** (render+encode's peak + the encoder's, an upper bound) |";
+  for (const SizeResult& r : results) {
+    const double video = r.stage_peak_mb.count("render+encode") ? r.stage_peak_mb.at("render+encode") : 0;
+    md << " |" << cell(" **%.0f** |", std::max(r.peak_mb, video + r.encoder_peak_mb));
+  }
   md << "\n| planes |";
   for (const SizeResult& r : results) md << " " << r.planes << " | |";
   // The slicer runs on the depth network's output, so both work at the same resolution;
@@ -265,7 +280,7 @@ int pipeline_benchmark(const PipelineBenchOptions& o) {
   fs::create_directories(scratch);
   std::vector<SizeResult> results;
   try {
-    for (cv::Size size : {cv::Size(1024, 768), cv::Size(3840, 2160)}) {
+    for (cv::Size size : o.sizes) {
       std::fprintf(stderr, "ampi bench pipeline: %dx%d ...\n", size.width, size.height);
       results.push_back(measure(source, size, o.runs, o.mpi, video, scratch));
       measure_slicing_share(source, o.mpi, kSlicingShareReps, results.back());

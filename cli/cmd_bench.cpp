@@ -3,9 +3,11 @@
 // pipeline benchmarks' options are parsed here, with the parser of the other subcommands,
 // so bench/ needs nothing from cli/.
 #include <cstdio>
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "bench/bench.h"
 #include "bench/network_bench.h"
@@ -52,12 +54,13 @@ int bench_network(int argc, char** argv) {
 }
 
 const char kPipelineUsage[] =
-    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N]\n"
+    "usage: ampi bench pipeline [--photo FILE] [--runs N] [--threads N] [--frames N] [--sizes LIST]\n"
     "                           [--inpainter network|harmonic|push-pull] [--working-size N] [--out FILE]\n"
     "\n"
     "Times every stage of `ampi run` (decode, depth, depth edges, slicing, assembly,\n"
     "inpainting, MPI write, render + encode of the video) on PHOTO resized to 1024x768 and\n"
-    "to 3840x2160, medians of N runs, and each stage's peak resident memory. Also slicing's\n"
+    "to 3840x2160, medians of N runs, and each stage's peak resident memory (and the video\n"
+    "encoder's, when the ffmpeg program encodes the MP4 in its own process). Also slicing's\n"
     "time as a share of the depth network's (both run at the same working resolution), and\n"
     "photo to MPI with and without depth edges, run by run. Writes the table to\n"
     "bench/RESULTS-pipeline.md.\n"
@@ -66,9 +69,29 @@ const char kPipelineUsage[] =
     "  --runs N       runs per size (default 3)\n"
     "  --threads N    worker threads (default 2)\n"
     "  --frames N     video frames rendered and encoded per run (default 30)\n"
+    "  --sizes LIST   comma-separated WxH sizes (default 1024x768,3840x2160)\n"
     "  --inpainter NAME      network (default, as ampi run), harmonic or push-pull\n"
     "  --working-size N      the depth network's working size (default: the weight file's)\n"
     "  --out FILE     default bench/RESULTS-pipeline.md\n";
+
+// "1024x768,3840x2160": each side at least kMinPhotoSide.
+std::vector<cv::Size> parse_sizes(const std::string& option, const std::string& text) {
+  std::vector<cv::Size> sizes;
+  size_t start = 0;
+  while (start <= text.size()) {
+    const size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    int width = 0, height = 0;
+    char extra = 0;
+    if (std::sscanf(item.c_str(), "%dx%d%c", &width, &height, &extra) != 2 || width < kMinPhotoSide ||
+        height < kMinPhotoSide || width > 16384 || height > 16384)
+      throw std::runtime_error(option + ": '" + item + "' is not a size WxH with sides from " +
+                               std::to_string(kMinPhotoSide) + " to 16384");
+    sizes.emplace_back(width, height);
+    start = end + 1;
+  }
+  return sizes;
+}
 
 int bench_pipeline(int argc, char** argv) {
   bench::PipelineBenchOptions o;
@@ -80,6 +103,7 @@ int bench_pipeline(int argc, char** argv) {
   p.option("--out", &o.out);
   p.option("--inpainter", [&](const std::string& v) { o.mpi.inpainter = parse_inpainter(v); });
   p.option("--working-size", &o.mpi.working_size, kMinPhotoSide, 16384);
+  p.option("--sizes", [&](const std::string& v) { o.sizes = parse_sizes("--sizes", v); });
   if (!p.parse(argc, argv)) return 0;
   return bench::pipeline_benchmark(o);
 }

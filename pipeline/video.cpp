@@ -68,13 +68,13 @@ std::vector<Pose> video_poses(const Mpi& mpi, const VideoOptions& options) {
   return poses;
 }
 
-int render_video(const Renderer& renderer, const std::vector<Pose>& poses, double baseline,
-                 const VideoOptions& options, const std::string& path, bool overwrite,
-                 ThreadPool& pool) {
+VideoWritten render_video(const Renderer& renderer, const std::vector<Pose>& poses, double baseline,
+                          const VideoOptions& options, const std::string& path, bool overwrite,
+                          ThreadPool& pool) {
   FrameWriter writer(path, options.container, options.path.fps, overwrite);
   render_frames(renderer, poses, options.stereo, baseline, writer, pool);
   writer.finish();
-  return writer.frames();
+  return {writer.frames(), writer.encoder_peak_mb()};
 }
 
 // Relative to the nearest plane, so the stereo budget is the same whatever the scale.
@@ -84,19 +84,19 @@ double stereo_baseline(const Mpi& mpi, const VideoOptions& options) {
 
 }  // namespace
 
-int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
-                bool overwrite, ThreadPool& pool) {
+VideoWritten write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
+                         bool overwrite, ThreadPool& pool) {
   const std::vector<Pose> poses = video_poses(mpi, options);
   const Renderer renderer(mpi);
   return render_video(renderer, poses, stereo_baseline(mpi, options), options, path, overwrite, pool);
 }
 
-int write_video(Mpi&& mpi, const VideoOptions& options, const std::string& path, bool overwrite,
-                ThreadPool& pool) {
+VideoWritten write_video(Mpi&& mpi, const VideoOptions& options, const std::string& path, bool overwrite,
+                         ThreadPool& pool) {
   const std::vector<Pose> poses = video_poses(mpi, options);
-  const Renderer renderer(mpi);
-  std::vector<cv::Mat>().swap(mpi.layers);  // the renderer has its own copy
-  return render_video(renderer, poses, stereo_baseline(mpi, options), options, path, overwrite, pool);
+  const double baseline = stereo_baseline(mpi, options);
+  const Renderer renderer(std::move(mpi));  // lets each layer go once it holds its own copy
+  return render_video(renderer, poses, baseline, options, path, overwrite, pool);
 }
 
 }  // namespace ampi

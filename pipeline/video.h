@@ -34,14 +34,22 @@ StereoMode parse_stereo_mode(const std::string& name);
 // video.mp4, video.gif or frames/ (a PNG sequence).
 std::string video_file_name(Container container);
 
-// Renders the whole path into `path` (staged by FrameWriter: all or nothing). Returns
-// the number of frames written.
-int write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
-                bool overwrite, ThreadPool& pool = default_pool());
-// The same, consuming the MPI: its 8-bit layers are released once the renderer holds
-// its own copy of them, so they are not kept through the encoding (at 4K, 265 MB of 8
+// What writing a video did.
+struct VideoWritten {
+  int frames = 0;
+  // The peak resident memory (MB) of the ffmpeg process that encoded an MP4, beside this
+  // process's own; 0 when this process encoded it (render/video_out.h).
+  double encoder_peak_mb = 0;
+};
+
+// Renders the whole path into `path` (staged by FrameWriter: all or nothing), one frame
+// at a time straight into the encoder.
+VideoWritten write_video(const Mpi& mpi, const VideoOptions& options, const std::string& path,
+                         bool overwrite, ThreadPool& pool = default_pool());
+// The same, consuming the MPI: each 8-bit layer is released as soon as the renderer
+// holds its own copy, so they are not kept through the encoding (at 4K, 265 MB of 8
 // layers beside the renderer's 530 MB and the encoder's frames).
-int write_video(Mpi&& mpi, const VideoOptions& options, const std::string& path, bool overwrite,
-                ThreadPool& pool = default_pool());
+VideoWritten write_video(Mpi&& mpi, const VideoOptions& options, const std::string& path, bool overwrite,
+                         ThreadPool& pool = default_pool());
 
 }  // namespace ampi

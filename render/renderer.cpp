@@ -16,18 +16,29 @@ constexpr int kPadBefore = 1;
 constexpr int kPadAfter = 2;
 
 // Straight-alpha BGRA bytes to premultiplied BGRA floats in [0, 1].
+void premultiply_row(const uint8_t* in, int width, float* out) {
+  for (int x = 0; x < width; ++x, in += 4, out += 4) {
+    const float alpha = in[3] / 255.0f;
+    for (int k = 0; k < 3; ++k) out[k] = in[k] / 255.0f * alpha;
+    out[3] = alpha;
+  }
+}
+
 cv::Mat premultiply(const cv::Mat& bgra) {
   cv::Mat out(bgra.size(), CV_32FC4);
-  for (int y = 0; y < bgra.rows; ++y) {
-    const uint8_t* in = bgra.ptr<uint8_t>(y);
-    float* o = out.ptr<float>(y);
-    for (int x = 0; x < bgra.cols; ++x, in += 4, o += 4) {
-      const float alpha = in[3] / 255.0f;
-      for (int k = 0; k < 3; ++k) o[k] = in[k] / 255.0f * alpha;
-      o[3] = alpha;
-    }
-  }
+  for (int y = 0; y < bgra.rows; ++y) premultiply_row(bgra.ptr<uint8_t>(y), bgra.cols, out.ptr<float>(y));
   return out;
+}
+
+// premultiply(bgra) converted to half floats into `halves`, a row at a time: the float
+// image of a whole layer (133 MB at 3840x2160) is never held.
+void premultiply_to_half(const cv::Mat& bgra, cv::Mat& halves) {
+  cv::Mat row(1, bgra.cols, CV_32FC4);
+  for (int y = 0; y < bgra.rows; ++y) {
+    premultiply_row(bgra.ptr<uint8_t>(y), bgra.cols, row.ptr<float>());
+    cv::Mat out = halves.row(y);
+    row.convertTo(out, CV_16F);
+  }
 }
 
 render::InverseHomography to_float(const cv::Matx33d& m) {
@@ -113,7 +124,7 @@ Renderer::Layer Renderer::prepare_layer(const cv::Mat& bgra, double depth) {
   layer.padded = cv::Mat(bgra.rows + kPadBefore + kPadAfter, bgra.cols + kPadBefore + kPadAfter,
                          CV_16FC4, cv::Scalar::all(0));
   cv::Mat inside = layer.padded(cv::Rect(kPadBefore, kPadBefore, bgra.cols, bgra.rows));
-  premultiply(bgra).convertTo(inside, CV_16F);
+  premultiply_to_half(bgra, inside);
   layer.view.origin = reinterpret_cast<const uint16_t*>(inside.data);
   layer.view.stride = static_cast<int64_t>(layer.padded.step1() / 4);
   layer.view.width = bgra.cols;
@@ -124,12 +135,27 @@ Renderer::Layer Renderer::prepare_layer(const cv::Mat& bgra, double depth) {
 
 Renderer::Renderer(const Mpi& mpi, RendererOptions options)
     : camera_(mpi.camera), options_(options), kernels_(render::composite_kernels(options.isa)) {
-  validate_mpi(mpi);
-  if (options_.tile_width < 1 || options_.tile_height < 1)
-    throw std::invalid_argument("renderer tiles must be at least 1x1 pixels");
+  check_setup(mpi);
   layers_.reserve(mpi.layers.size());
   for (size_t j = 0; j < mpi.layers.size(); ++j)
     layers_.push_back(prepare_layer(mpi.layers[j], mpi.planes[j].depth));
+}
+
+Renderer::Renderer(Mpi&& mpi, RendererOptions options)
+    : camera_(mpi.camera), options_(options), kernels_(render::composite_kernels(options.isa)) {
+  check_setup(mpi);
+  layers_.reserve(mpi.layers.size());
+  for (size_t j = 0; j < mpi.layers.size(); ++j) {
+    layers_.push_back(prepare_layer(mpi.layers[j], mpi.planes[j].depth));
+    mpi.layers[j].release();
+  }
+  std::vector<cv::Mat>().swap(mpi.layers);
+}
+
+void Renderer::check_setup(const Mpi& mpi) const {
+  validate_mpi(mpi);
+  if (options_.tile_width < 1 || options_.tile_height < 1)
+    throw std::invalid_argument("renderer tiles must be at least 1x1 pixels");
 }
 
 // Camera moves parallel to the image plane (no rotation, zoom or motion along z) make

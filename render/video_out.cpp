@@ -1,8 +1,13 @@
 #include "render/video_out.h"
 
+#include <fcntl.h>
+#include <signal.h>
 #include <spawn.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
 
 #include <cstdio>
 #include <cstdlib>
@@ -63,15 +68,101 @@ void move_into_place(const std::string& staging, const std::string& dest) {
   if (!aside.empty()) fs::remove_all(aside, error);
 }
 
-int run_program(const std::vector<std::string>& args) {
+std::vector<char*> argv_of(const std::vector<std::string>& args) {
   std::vector<char*> argv;
   for (const std::string& a : args) argv.push_back(const_cast<char*>(a.c_str()));
   argv.push_back(nullptr);
+  return argv;
+}
+
+// The exit status of a finished child (-1 if it did not exit by itself).
+int wait_for(pid_t pid) {
+  int status = 0;
+  pid_t waited;
+  do waited = ::waitpid(pid, &status, 0);
+  while (waited < 0 && errno == EINTR);
+  if (waited < 0) return -1;
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Whether the child has exited (it stays a zombie until wait_for reaps it).
+bool has_exited(pid_t pid) {
+  siginfo_t info{};
+  const int result = ::waitid(P_PID, static_cast<id_t>(pid), &info, WEXITED | WNOHANG | WNOWAIT);
+  return result != 0 || info.si_pid == pid;  // an error: nothing left to wait for
+}
+
+// A running process's peak resident memory in MB (VmHWM), 0 where /proc cannot tell.
+// Not the rusage of the reaped child: a child started by vfork and exec inherits its
+// parent's peak there (Linux keeps the replaced memory map's high-water mark).
+double peak_resident_mb(pid_t pid) {
+  std::FILE* f = std::fopen(("/proc/" + std::to_string(pid) + "/status").c_str(), "r");
+  if (!f) return 0;
+  char line[256];
+  long kb = 0;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "VmHWM: %ld", &kb) == 1) break;
+  std::fclose(f);
+  return kb / 1024.0;
+}
+
+int run_program(const std::vector<std::string>& args) {
+  std::vector<char*> argv = argv_of(args);
   pid_t pid;
   if (posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ) != 0) return -1;
-  int status = 0;
-  if (waitpid(pid, &status, 0) < 0) return -1;
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return wait_for(pid);
+}
+
+// Starts `args` with its stdin reading from a new pipe (its write end into *input) and
+// its stdout and stderr on /dev/null. Returns the child's pid, or -1.
+pid_t spawn_with_input_pipe(const std::vector<std::string>& args, int* input) {
+  int fds[2];
+  if (::pipe2(fds, O_CLOEXEC) != 0) return -1;
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, fds[0], STDIN_FILENO);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, "/dev/null", O_WRONLY, 0);
+  posix_spawn_file_actions_addopen(&actions, STDERR_FILENO, "/dev/null", O_WRONLY, 0);
+  std::vector<char*> argv = argv_of(args);
+  pid_t pid;
+  const int failed = posix_spawnp(&pid, argv[0], &actions, nullptr, argv.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  ::close(fds[0]);
+  if (failed) {
+    ::close(fds[1]);
+    return -1;
+  }
+  *input = fds[1];
+  return pid;
+}
+
+// Whether the ffmpeg program on PATH can encode with libx264 (Debian's can; a minimal
+// build may not): one tiny frame encoded to nowhere, tried once per process.
+bool ffmpeg_encodes_h264() {
+  if (!program_on_path("ffmpeg")) return false;
+  static const bool encodes = [] {
+    int input = -1;
+    const pid_t pid = spawn_with_input_pipe(
+        {"ffmpeg", "-nostdin", "-v", "error", "-f", "lavfi", "-i", "color=s=16x16:d=0.04", "-c:v", "libx264",
+         "-f", "null", "-"},
+        &input);
+    if (pid < 0) return false;
+    ::close(input);
+    return wait_for(pid) == 0;
+  }();
+  return encodes;
+}
+
+// Writes all of [data, data + size) to fd; false if the reader went away.
+bool write_all(int fd, const uint8_t* data, size_t size) {
+  while (size > 0) {
+    const ssize_t n = ::write(fd, data, size);
+    if (n < 0 && errno == EINTR) continue;
+    if (n <= 0) return false;
+    data += n;
+    size -= static_cast<size_t>(n);
+  }
+  return true;
 }
 
 }  // namespace
@@ -127,13 +218,70 @@ FrameWriter::FrameWriter(const std::string& path, Container container, double fp
 
 FrameWriter::~FrameWriter() {
   if (finished_) return;
+  stop_encoder();
   video_.release();
   std::error_code ignored;
   fs::remove_all(staging_, ignored);
   fs::remove(staging_ + ".gif", ignored);
 }
 
+const char* const kMp4EncoderSettings = "rc-lookahead=10:sync-lookahead=0:threads=2";
+
+void FrameWriter::start_encoder(cv::Size size) {
+  // A reader that dies would otherwise kill this process with SIGPIPE on the next write;
+  // ignored, the write fails with EPIPE and the error names the video.
+  ::signal(SIGPIPE, SIG_IGN);
+  char fps[32];
+  std::snprintf(fps, sizeof fps, "%.6g", fps_);
+  encoder_pid_ = spawn_with_input_pipe(
+      {"ffmpeg", "-nostdin", "-v", "error", "-y", "-f", "rawvideo", "-pix_fmt", "bgr24", "-s",
+       std::to_string(size.width) + "x" + std::to_string(size.height), "-framerate", fps, "-i", "pipe:0",
+       "-an", "-c:v", "libx264", "-preset", "medium", "-crf", "23", "-pix_fmt", "yuv420p", "-x264-params",
+       kMp4EncoderSettings, "-f", "mp4", staging_},
+      &encoder_input_);
+  if (encoder_pid_ < 0) fail(path_, "cannot start the ffmpeg program to encode the video");
+}
+
+void FrameWriter::send_to_encoder(const cv::Mat& bgr) {
+  bool sent = true;
+  if (bgr.isContinuous())
+    sent = write_all(encoder_input_, bgr.data, bgr.total() * bgr.elemSize());
+  else
+    for (int y = 0; y < bgr.rows && sent; ++y)
+      sent = write_all(encoder_input_, bgr.ptr<uint8_t>(y), bgr.cols * bgr.elemSize());
+  if (!sent) fail(path_, "the ffmpeg program stopped while encoding the video");
+  // x264 holds its most frames once its lookahead is full; flushing at the end adds none.
+  encoder_peak_mb_ = std::max(encoder_peak_mb_, peak_resident_mb(encoder_pid_));
+}
+
+void FrameWriter::finish_encoder() {
+  if (encoder_pid_ < 0) return;
+  ::close(encoder_input_);  // end of input: ffmpeg flushes x264 and writes the MP4's index
+  encoder_input_ = -1;
+  // Frames sit in the pipe and in x264's lookahead when the last one is handed over, so
+  // the peak is followed until the encoder exits.
+  while (!has_exited(encoder_pid_)) {
+    encoder_peak_mb_ = std::max(encoder_peak_mb_, peak_resident_mb(encoder_pid_));
+    ::usleep(5000);
+  }
+  const int status = wait_for(encoder_pid_);
+  encoder_pid_ = -1;
+  if (status != 0) fail(path_, "ffmpeg could not encode the video (exit status " + std::to_string(status) + ")");
+}
+
+// A writer given up on: the encoder is stopped rather than left to finish a file that
+// will be deleted.
+void FrameWriter::stop_encoder() {
+  if (encoder_pid_ < 0) return;
+  ::close(encoder_input_);
+  ::kill(encoder_pid_, SIGTERM);
+  wait_for(encoder_pid_);
+  encoder_pid_ = -1;
+  encoder_input_ = -1;
+}
+
 void FrameWriter::open_video(cv::Size size) {
+  if (ffmpeg_encodes_h264()) return start_encoder(size);
   // The FFmpeg backend logs its own complaint when a codec is missing; we report ours.
   const auto level = cv::utils::logging::setLogLevel(cv::utils::logging::LOG_LEVEL_SILENT);
   video_.open(staging_, cv::VideoWriter::fourcc('a', 'v', 'c', '1'), fps_, size);
@@ -169,7 +317,10 @@ void FrameWriter::add(const cv::Mat& bgr) {
       if (bgr.cols % 2 || bgr.rows % 2)
         cv::copyMakeBorder(bgr, even, 0, bgr.rows % 2, 0, bgr.cols % 2, cv::BORDER_REPLICATE);
       if (frames_ == 0) open_video(even.size());
-      video_.write(even);
+      if (encoder_pid_ >= 0)
+        send_to_encoder(even);
+      else
+        video_.write(even);
       break;
     }
     case Container::Gif:
@@ -196,6 +347,7 @@ void FrameWriter::finish() {
   if (!overwrite_ && fs::symlink_status(path_).type() != fs::file_type::not_found)
     fail(path_, "appeared while rendering; not replaced (use --force to replace it)");
   video_.release();
+  finish_encoder();
   if (container_ == Container::Gif) {
     encode_gif();
     move_into_place(staging_ + ".gif", path_);

@@ -13,7 +13,10 @@
 namespace ampi {
 
 enum class Container {
-  Mp4,          // H.264 through OpenCV's video writer (MPEG-4 Part 2 if H.264 is missing)
+  // H.264: through the ffmpeg program when it is on PATH and has libx264, with x264's
+  // frame buffers bounded (kMp4EncoderSettings); otherwise through OpenCV's video writer
+  // (MPEG-4 Part 2 if H.264 is missing there too).
+  Mp4,
   Gif,          // through the ffmpeg program, with a palette computed for the clip
   PngSequence,  // a directory of frame_000000.png, frame_000001.png, ...
   Png,          // a single frame
@@ -46,11 +49,18 @@ class FrameWriter {
   void finish();
 
   int frames() const { return frames_; }
+  // The peak resident memory (MB) of the ffmpeg process encoding the MP4, as of the
+  // last frame given to it; 0 when OpenCV encodes it (its memory is this process's own).
+  double encoder_peak_mb() const { return encoder_peak_mb_; }
   // A remark for the user about how the output was made (empty if nothing to say).
   const std::string& note() const { return note_; }
 
  private:
   void open_video(cv::Size size);
+  void start_encoder(cv::Size size);
+  void send_to_encoder(const cv::Mat& bgr);
+  void finish_encoder();
+  void stop_encoder();
   void write_png(const std::string& file, const cv::Mat& bgr) const;
   void encode_gif() const;
 
@@ -61,8 +71,18 @@ class FrameWriter {
   int frames_ = 0;
   cv::Size size_;
   cv::VideoWriter video_;
+  int encoder_pid_ = -1;    // the ffmpeg process encoding the MP4, fed raw frames
+  int encoder_input_ = -1;  // the write end of its stdin
+  double encoder_peak_mb_ = 0;
   std::string note_;
 };
+
+// What the ffmpeg program is asked to give x264 for MP4s. Left to itself x264 keeps a
+// 40-frame lookahead and 1.5 frame threads per core, each frame with its half-pel planes:
+// 1.5 GB at 3840x2160 on two cores, more with more cores. Ten frames of lookahead and two
+// threads hold about 0.7 GB at that size, whatever the core count; the file is about the
+// same size at the same CRF.
+extern const char* const kMp4EncoderSettings;
 
 // The two eyes of a stereo pair around `centre`: cameras moved by -baseline/2 and
 // +baseline/2 along the view's own x axis (scene units).

@@ -168,6 +168,20 @@ TEST_CASE("tile sizes and thread counts give identical frames") {
   }
 }
 
+TEST_CASE("a renderer that consumes its MPI draws the same frames and leaves no layers") {
+  const Mpi mpi = test::synthetic_mpi(150, 90, 5, 53, test::Alpha::Soft);
+  Mpi consumed = mpi;
+  for (cv::Mat& layer : consumed.layers) layer = layer.clone();  // nothing shared with mpi
+  const Renderer kept(mpi), took(std::move(consumed));
+  CHECK(consumed.layers.empty());
+  CHECK(consumed.planes.size() == mpi.planes.size());
+  int pose_index = 0;
+  for (const Pose& pose : test_poses()) {
+    INFO("pose " << pose_index++ << ", seed 53");
+    CHECK(max_difference(took.render(pose), kept.render(pose)) == 0);
+  }
+}
+
 TEST_CASE("culling empty and hidden planes leaves every pixel unchanged") {
   // Binary discs give tiles covered by an opaque plane (the planes behind are skipped)
   // and tiles a plane misses (skipped too); small tiles make both frequent.

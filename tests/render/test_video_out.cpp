@@ -83,9 +83,10 @@ TEST_CASE("PNG sequences and single PNGs appear only when finished, pixel for pi
   CHECK(entries(dir.path()) == std::vector<std::string>{"frames", "one.png"});
 }
 
-TEST_CASE("MP4 videos hold every frame, padded to an even size") {
-  test::TempDir dir;
-  const std::string path = dir.file("clip.mp4");
+// Writes ten frames of odd size to `name` and checks what a reader gets back; returns the
+// writer's encoder peak.
+double check_mp4(const test::TempDir& dir, const std::string& name) {
+  const std::string path = dir.file(name);
   FrameWriter w(path, Container::Mp4, 30, false);
   for (int k = 0; k < 10; ++k) w.add(test_frame(k));
   w.finish();
@@ -106,7 +107,31 @@ TEST_CASE("MP4 videos hold every frame, padded to an even size") {
     ++count;
   }
   CHECK(count == 10);
-  CHECK(entries(dir.path()) == std::vector<std::string>{"clip.mp4"});
+  return w.encoder_peak_mb();
+}
+
+TEST_CASE("MP4 videos hold every frame, padded to an even size, through ffmpeg or OpenCV") {
+  test::TempDir dir;
+  {
+    ScopedPath no_programs(dir.path().string());
+    CHECK(check_mp4(dir, "opencv.mp4") == 0);  // encoded in this process
+  }
+  if (!program_on_path("ffmpeg")) {
+    WARN("ffmpeg is not installed: MP4 encoding through it not tested");
+    CHECK(entries(dir.path()) == std::vector<std::string>{"opencv.mp4"});
+    return;
+  }
+  CHECK(check_mp4(dir, "piped.mp4") > 0);  // the encoder's own peak, measured when it exits
+  CHECK(entries(dir.path()) == std::vector<std::string>{"opencv.mp4", "piped.mp4"});
+}
+
+TEST_CASE("an MP4 given up on leaves nothing behind and stops its encoder") {
+  test::TempDir dir;
+  {
+    FrameWriter w(dir.file("abandoned.mp4"), Container::Mp4, 30, false);
+    for (int k = 0; k < 3; ++k) w.add(test_frame(k));
+  }
+  CHECK(entries(dir.path()).empty());
 }
 
 TEST_CASE("GIFs are made by ffmpeg, or refused up front with the reason") {
