@@ -1,5 +1,6 @@
 // AVX-512 transformer row kernels (contracts in kernels/kernel_list.def): as the AVX2
-// ones, 16 floats a vector, tails through mask registers.
+// ones, 16 floats a vector, whole vectors through plain loads and stores, the tail
+// through mask registers.
 #include <cmath>
 
 // GCC 12 warns that the _mm512_undefined_ps() inside its own reduction and max intrinsics
@@ -56,7 +57,12 @@ void layer_norm_row(const float* in, int c, const float* gamma, const float* bet
   const __m512 inv_std =
       _mm512_set1_ps(1.0f / std::sqrt(squared_deviations(in, c, mean) / static_cast<float>(c) + eps));
   const __m512 m = _mm512_set1_ps(mean);
-  for (int i = 0; i < c; i += 16) {
+  int i = 0;
+  for (; i + 16 <= c; i += 16) {
+    const __m512 d = _mm512_mul_ps(_mm512_sub_ps(_mm512_loadu_ps(in + i), m), inv_std);
+    _mm512_storeu_ps(out + i, _mm512_fmadd_ps(d, _mm512_loadu_ps(gamma + i), _mm512_loadu_ps(beta + i)));
+  }
+  if (i < c) {
     const __mmask16 mask = tail_mask(c - i);
     const __m512 d = _mm512_mul_ps(_mm512_sub_ps(_mm512_maskz_loadu_ps(mask, in + i), m), inv_std);
     _mm512_mask_storeu_ps(out + i, mask,
@@ -76,7 +82,13 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   // As the reference: a block whose every score is -inf contributes nothing, not NaN.
   const __m512 shift = _mm512_set1_ps(new_max == -INFINITY ? 0.0f : new_max);
   __m512 vsum = _mm512_setzero_ps();
-  for (int j = 0; j < n; j += 16) {
+  int j = 0;
+  for (; j + 16 <= n; j += 16) {
+    const __m512 e = exp(_mm512_sub_ps(_mm512_mul_ps(_mm512_loadu_ps(scores + j), s), shift));
+    _mm512_storeu_ps(scores + j, e);
+    vsum = _mm512_add_ps(vsum, e);
+  }
+  if (j < n) {
     const __mmask16 mask = tail_mask(n - j);
     const __m512 e = exp(_mm512_sub_ps(_mm512_mul_ps(_mm512_maskz_loadu_ps(mask, scores + j), s), shift));
     _mm512_mask_storeu_ps(scores + j, mask, e);
@@ -97,7 +109,14 @@ void bilinear_row(const float* top, const float* bottom, float wy, const int32_t
     const float *b0 = bottom + int64_t{x0[x]} * c, *b1 = bottom + int64_t{x1[x]} * c;
     float* o = out + int64_t{x} * c;
     const __m512 vx = _mm512_set1_ps(wx[x]);
-    for (int ch = 0; ch < c; ch += 16) {
+    int ch = 0;
+    for (; ch + 16 <= c; ch += 16) {
+      const __m512 t0v = _mm512_loadu_ps(t0 + ch), b0v = _mm512_loadu_ps(b0 + ch);
+      const __m512 t = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_loadu_ps(t1 + ch), t0v), t0v);
+      const __m512 b = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_loadu_ps(b1 + ch), b0v), b0v);
+      _mm512_storeu_ps(o + ch, _mm512_fmadd_ps(vy, _mm512_sub_ps(b, t), t));
+    }
+    if (ch < c) {
       const __mmask16 mask = tail_mask(c - ch);
       const __m512 t0v = _mm512_maskz_loadu_ps(mask, t0 + ch), b0v = _mm512_maskz_loadu_ps(mask, b0 + ch);
       const __m512 t = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_maskz_loadu_ps(mask, t1 + ch), t0v), t0v);
