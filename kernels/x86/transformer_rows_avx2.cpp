@@ -107,8 +107,39 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   return factor;
 }
 
+namespace {
+
+// One channel (a depth map resized to the photo): 8 output columns a vector, their 4 taps
+// gathered; masked-off lanes gather column 0, which every row has.
+__m256 bilinear_columns(const float* top, const float* bottom, __m256 vy, __m256i i0, __m256i i1, __m256 vx) {
+  const __m256 t0 = _mm256_i32gather_ps(top, i0, 4), t1 = _mm256_i32gather_ps(top, i1, 4);
+  const __m256 b0 = _mm256_i32gather_ps(bottom, i0, 4), b1 = _mm256_i32gather_ps(bottom, i1, 4);
+  const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(t1, t0), t0);
+  const __m256 b = _mm256_fmadd_ps(vx, _mm256_sub_ps(b1, b0), b0);
+  return _mm256_fmadd_ps(vy, _mm256_sub_ps(b, t), t);
+}
+
+void bilinear_row_one_channel(const float* top, const float* bottom, float wy, const int32_t* x0,
+                              const int32_t* x1, const float* wx, int out_w, float* out) {
+  const __m256 vy = _mm256_set1_ps(wy);
+  int x = 0;
+  for (; x + 8 <= out_w; x += 8) {
+    const __m256i i0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(x0 + x));
+    const __m256i i1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(x1 + x));
+    _mm256_storeu_ps(out + x, bilinear_columns(top, bottom, vy, i0, i1, _mm256_loadu_ps(wx + x)));
+  }
+  if (x < out_w) {
+    const __m256i mask = tail_mask(out_w - x);
+    const __m256i i0 = _mm256_maskload_epi32(x0 + x, mask), i1 = _mm256_maskload_epi32(x1 + x, mask);
+    _mm256_maskstore_ps(out + x, mask, bilinear_columns(top, bottom, vy, i0, i1, _mm256_maskload_ps(wx + x, mask)));
+  }
+}
+
+}  // namespace
+
 void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
                   const float* wx, int out_w, int c, float* out) {
+  if (c == 1) return bilinear_row_one_channel(top, bottom, wy, x0, x1, wx, out_w, out);
   const __m256 vy = _mm256_set1_ps(wy);
   for (int x = 0; x < out_w; ++x) {
     const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;

@@ -101,8 +101,30 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   return factor;
 }
 
+namespace {
+
+// One channel (a depth map resized to the photo): 16 output columns a vector, their 4 taps
+// gathered; masked-off lanes gather column 0, which every row has.
+void bilinear_row_one_channel(const float* top, const float* bottom, float wy, const int32_t* x0,
+                              const int32_t* x1, const float* wx, int out_w, float* out) {
+  const __m512 vy = _mm512_set1_ps(wy);
+  for (int x = 0; x < out_w; x += 16) {
+    const __mmask16 mask = tail_mask(out_w - x);
+    const __m512i i0 = _mm512_maskz_loadu_epi32(mask, x0 + x), i1 = _mm512_maskz_loadu_epi32(mask, x1 + x);
+    const __m512 vx = _mm512_maskz_loadu_ps(mask, wx + x);
+    const __m512 t0 = _mm512_i32gather_ps(i0, top, 4), t1 = _mm512_i32gather_ps(i1, top, 4);
+    const __m512 b0 = _mm512_i32gather_ps(i0, bottom, 4), b1 = _mm512_i32gather_ps(i1, bottom, 4);
+    const __m512 t = _mm512_fmadd_ps(vx, _mm512_sub_ps(t1, t0), t0);
+    const __m512 b = _mm512_fmadd_ps(vx, _mm512_sub_ps(b1, b0), b0);
+    _mm512_mask_storeu_ps(out + x, mask, _mm512_fmadd_ps(vy, _mm512_sub_ps(b, t), t));
+  }
+}
+
+}  // namespace
+
 void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
                   const float* wx, int out_w, int c, float* out) {
+  if (c == 1) return bilinear_row_one_channel(top, bottom, wy, x0, x1, wx, out_w, out);
   const __m512 vy = _mm512_set1_ps(wy);
   for (int x = 0; x < out_w; ++x) {
     const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;
