@@ -1,5 +1,5 @@
 // Vector activation functions for NEON (4 floats). Include only from *_neon.cpp files.
-// exp and exp2_nonpositive evaluate the polynomials of kernels/exp_polynomials.h.
+// exp, exp2_nonpositive and gelu evaluate the polynomials of kernels/exp_polynomials.h.
 #pragma once
 #include <arm_neon.h>
 
@@ -43,12 +43,17 @@ inline float32x4_t sigmoid(float32x4_t x) {
   return vdivq_f32(one, vaddq_f32(one, exp(vnegq_f32(x))));
 }
 
-// GELU lane by lane through the scalar reference's formula (kernels/activation.h).
+// gelu(x) = x Phi(x) by the reference's formula (kernels/activation.h): the tail
+// h = exp(-x^2 / 2) Q(min(|x|, kMaxArg)), 0 past kZeroArg; Phi = 1 - h for x >= 0, else h.
 inline float32x4_t gelu(float32x4_t x) {
-  alignas(16) float v[4];
-  vst1q_f32(v, x);
-  for (float& f : v) f = ampi::gelu(f);
-  return vld1q_f32(v);
+  using namespace erfc_poly;
+  const float32x4_t ax = vabsq_f32(x);
+  const float32x4_t t = vsubq_f32(vminq_f32(ax, vdupq_n_f32(kMaxArg)), vdupq_n_f32(kCentre));
+  const float32x4_t e = exp(vmulq_f32(vdupq_n_f32(-0.5f), vmulq_f32(x, x)));
+  const uint32x4_t in_range = vcleq_f32(ax, vdupq_n_f32(kZeroArg));
+  const float32x4_t h = vreinterpretq_f32_u32(vandq_u32(in_range, vreinterpretq_u32_f32(vmulq_f32(e, horner(kQ, t)))));
+  const uint32x4_t nonnegative = vcgeq_f32(x, vdupq_n_f32(0.0f));
+  return vmulq_f32(x, vbslq_f32(nonnegative, vsubq_f32(vdupq_n_f32(1.0f), h), h));
 }
 
 inline float32x4_t activate(float32x4_t x, ActivationSpec a) {

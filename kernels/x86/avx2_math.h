@@ -1,5 +1,5 @@
 // Vector activation functions for AVX2 (8 floats). Include only from *_avx2.cpp files.
-// exp and exp2_nonpositive evaluate the polynomials of kernels/exp_polynomials.h.
+// exp, exp2_nonpositive and gelu evaluate the polynomials of kernels/exp_polynomials.h.
 #pragma once
 #include <immintrin.h>
 
@@ -46,12 +46,18 @@ inline __m256 sigmoid(__m256 x) {
   return _mm256_div_ps(one, _mm256_add_ps(one, exp(_mm256_sub_ps(_mm256_setzero_ps(), x))));
 }
 
-// GELU lane by lane through the scalar reference's formula (kernels/activation.h).
+// gelu(x) = x Phi(x) by the reference's formula (kernels/activation.h): the tail
+// h = exp(-x^2 / 2) Q(min(|x|, kMaxArg)), 0 past kZeroArg; Phi = 1 - h for x >= 0, else h.
 inline __m256 gelu(__m256 x) {
-  alignas(32) float v[8];
-  _mm256_store_ps(v, x);
-  for (float& f : v) f = ampi::gelu(f);
-  return _mm256_load_ps(v);
+  using namespace erfc_poly;
+  const __m256 one = _mm256_set1_ps(1.0f);
+  const __m256 ax = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x);
+  const __m256 t = _mm256_sub_ps(_mm256_min_ps(ax, _mm256_set1_ps(kMaxArg)), _mm256_set1_ps(kCentre));
+  const __m256 e = exp(_mm256_mul_ps(_mm256_set1_ps(-0.5f), _mm256_mul_ps(x, x)));
+  __m256 h = _mm256_mul_ps(e, horner(kQ, t));
+  h = _mm256_andnot_ps(_mm256_cmp_ps(ax, _mm256_set1_ps(kZeroArg), _CMP_GT_OQ), h);
+  const __m256 nonnegative = _mm256_cmp_ps(x, _mm256_setzero_ps(), _CMP_GE_OQ);
+  return _mm256_mul_ps(x, _mm256_blendv_ps(h, _mm256_sub_ps(one, h), nonnegative));
 }
 
 inline __m256 activate(__m256 x, ActivationSpec a) {

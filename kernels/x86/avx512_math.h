@@ -1,5 +1,5 @@
 // Vector activation functions for AVX-512 (16 floats). Include only from *_avx512.cpp.
-// exp and exp2_nonpositive evaluate the polynomials of kernels/exp_polynomials.h.
+// exp, exp2_nonpositive and gelu evaluate the polynomials of kernels/exp_polynomials.h.
 #pragma once
 #include <immintrin.h>
 
@@ -42,12 +42,17 @@ inline __m512 sigmoid(__m512 x) {
   return _mm512_div_ps(one, _mm512_add_ps(one, exp(_mm512_sub_ps(_mm512_setzero_ps(), x))));
 }
 
-// GELU lane by lane through the scalar reference's formula (kernels/activation.h).
+// gelu(x) = x Phi(x) by the reference's formula (kernels/activation.h): the tail
+// h = exp(-x^2 / 2) Q(min(|x|, kMaxArg)), 0 past kZeroArg; Phi = 1 - h for x >= 0, else h.
 inline __m512 gelu(__m512 x) {
-  alignas(64) float v[16];
-  _mm512_store_ps(v, x);
-  for (float& f : v) f = ampi::gelu(f);
-  return _mm512_load_ps(v);
+  using namespace erfc_poly;
+  const __m512 ax = _mm512_abs_ps(x);
+  const __m512 t = _mm512_sub_ps(_mm512_min_ps(ax, _mm512_set1_ps(kMaxArg)), _mm512_set1_ps(kCentre));
+  const __m512 e = exp(_mm512_mul_ps(_mm512_set1_ps(-0.5f), _mm512_mul_ps(x, x)));
+  const __mmask16 in_range = _mm512_cmp_ps_mask(ax, _mm512_set1_ps(kZeroArg), _CMP_LE_OQ);
+  const __m512 h = _mm512_maskz_mul_ps(in_range, e, horner(kQ, t));
+  const __mmask16 nonnegative = _mm512_cmp_ps_mask(x, _mm512_setzero_ps(), _CMP_GE_OQ);
+  return _mm512_mul_ps(x, _mm512_mask_sub_ps(h, nonnegative, _mm512_set1_ps(1.0f), h));
 }
 
 inline __m512 activate(__m512 x, ActivationSpec a) {

@@ -69,7 +69,9 @@ TEST_CASE("gelu: every ISA's activate matches the reference within a few ulp") {
     for (size_t i = 0; i < x.size(); ++i)
       if (ulps_apart(got[i], want[i]) > worst) worst = ulps_apart(got[i], want[i]), worst_x = x[i];
     INFO("isa " << isa_name(isa) << ", worst at x " << worst_x);
-    CHECK(worst <= 4.0f);
+    // The ISAs fuse multiply-adds that the baseline reference rounds twice: in exp's
+    // polynomial, Q's and h's product, a few ulp each.
+    CHECK(worst <= 8.0f);
   }
 }
 
@@ -178,8 +180,15 @@ TEST_CASE("softmax_block_row: every ISA matches the reference block by block") {
         INFO("earlier max " << earlier_max);
         CHECK(got_max == want_max);
         CHECK(ulps_apart(got_factor, want_factor) <= 4.0f);
-        CHECK(std::fabs(got_sum - want_sum) <= 1e-6f * want_sum);
-        for (int j = 0; j < n; ++j) CHECK(ulps_apart(got[j], want[j]) <= 4.0f);
+        // Summed in another order: the bound of n float additions of positive terms.
+        CHECK(std::fabs(got_sum - want_sum) <= std::ldexp(float(8 + n), -24) * want_sum);
+        // exp(s_j - m) within a few ulp, plus what rounding s_j = scores[j] * scale and
+        // s_j - m may move the exponent by: an ISA may fuse the two (one rounding where
+        // the reference has two).
+        for (int j = 0; j < n; ++j) {
+          const float exponent_error = std::ldexp(2.0f * std::fabs(scores[j] * 0.7f) + std::fabs(want_max), -23);
+          CHECK(std::fabs(got[j] - want[j]) <= want[j] * (std::ldexp(4.0f, -23) + exponent_error));
+        }
       }
     }
 }

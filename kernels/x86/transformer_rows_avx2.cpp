@@ -1,0 +1,118 @@
+// AVX2 transformer row kernels (contracts in kernels/kernel_list.def). Tails go through
+// masked loads and stores, so every element takes the vector path and no scalar helper
+// from a shared header is compiled with AVX2 flags (cmake/isa.cmake).
+#include <cmath>
+
+#include "kernels/x86/avx2_channels.h"
+#include "kernels/x86/avx2_kernels.h"
+#include "kernels/x86/avx2_math.h"
+
+namespace ampi::avx2 {
+namespace {
+
+// Lanes [0, left) set (all of them from 8 up).
+__m256i tail_mask(int left) {
+  return _mm256_cmpgt_epi32(_mm256_set1_epi32(left), _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7));
+}
+
+float horizontal_max(__m256 v) {
+  __m128 m = _mm_max_ps(_mm256_castps256_ps128(v), _mm256_extractf128_ps(v, 1));
+  m = _mm_max_ps(m, _mm_movehl_ps(m, m));
+  m = _mm_max_ss(m, _mm_movehdup_ps(m));
+  return _mm_cvtss_f32(m);
+}
+
+// sum of in[i] and sum of (in[i] - mean)^2, two accumulators each so consecutive adds
+// do not wait on each other.
+float row_sum(const float* in, int c) {
+  __m256 a = _mm256_setzero_ps(), b = _mm256_setzero_ps();
+  int i = 0;
+  for (; i + 16 <= c; i += 16) {
+    a = _mm256_add_ps(a, _mm256_loadu_ps(in + i));
+    b = _mm256_add_ps(b, _mm256_loadu_ps(in + i + 8));
+  }
+  for (; i < c; i += 8) a = _mm256_add_ps(a, _mm256_maskload_ps(in + i, tail_mask(c - i)));
+  return horizontal_sum(_mm256_add_ps(a, b));
+}
+
+float squared_deviations(const float* in, int c, float mean) {
+  const __m256 m = _mm256_set1_ps(mean);
+  __m256 a = _mm256_setzero_ps(), b = _mm256_setzero_ps();
+  int i = 0;
+  for (; i + 16 <= c; i += 16) {
+    const __m256 d0 = _mm256_sub_ps(_mm256_loadu_ps(in + i), m);
+    const __m256 d1 = _mm256_sub_ps(_mm256_loadu_ps(in + i + 8), m);
+    a = _mm256_fmadd_ps(d0, d0, a);
+    b = _mm256_fmadd_ps(d1, d1, b);
+  }
+  for (; i < c; i += 8) {
+    const __m256i mask = tail_mask(c - i);
+    // Masked-off lanes load 0; their deviation is zeroed before it is squared.
+    const __m256 d = _mm256_and_ps(_mm256_sub_ps(_mm256_maskload_ps(in + i, mask), m), _mm256_castsi256_ps(mask));
+    a = _mm256_fmadd_ps(d, d, a);
+  }
+  return horizontal_sum(_mm256_add_ps(a, b));
+}
+
+}  // namespace
+
+void layer_norm_row(const float* in, int c, const float* gamma, const float* beta, float eps, float* out) {
+  const float mean = row_sum(in, c) / static_cast<float>(c);
+  const __m256 inv_std = _mm256_div_ps(
+      _mm256_set1_ps(1.0f), _mm256_sqrt_ps(_mm256_set1_ps(squared_deviations(in, c, mean) / static_cast<float>(c) + eps)));
+  const __m256 m = _mm256_set1_ps(mean);
+  for (int i = 0; i < c; i += 8) {
+    const __m256i mask = tail_mask(c - i);
+    const __m256 d = _mm256_mul_ps(_mm256_sub_ps(_mm256_maskload_ps(in + i, mask), m), inv_std);
+    _mm256_maskstore_ps(out + i, mask,
+                        _mm256_fmadd_ps(d, _mm256_maskload_ps(gamma + i, mask), _mm256_maskload_ps(beta + i, mask)));
+  }
+}
+
+float softmax_block_row(float* scores, int n, float scale, float* running_max, float* running_sum) {
+  const __m256 s = _mm256_set1_ps(scale), minus_inf = _mm256_set1_ps(-INFINITY);
+  __m256 vmax = minus_inf;
+  for (int j = 0; j < n; j += 8) {
+    const __m256i mask = tail_mask(n - j);
+    const __m256 v = _mm256_mul_ps(_mm256_maskload_ps(scores + j, mask), s);
+    vmax = _mm256_max_ps(vmax, _mm256_blendv_ps(minus_inf, v, _mm256_castsi256_ps(mask)));
+  }
+  const float old_max = *running_max;
+  const float new_max = std::max(old_max, horizontal_max(vmax));
+  // As the reference: a block whose every score is -inf contributes nothing, not NaN.
+  const __m256 shift = _mm256_set1_ps(new_max == -INFINITY ? 0.0f : new_max);
+  __m256 vsum = _mm256_setzero_ps();
+  for (int j = 0; j < n; j += 8) {
+    const __m256i mask = tail_mask(n - j);
+    // Multiply, then subtract (not one FMA): the reference rounds s * scale first, and an
+    // exponent near the maximum must not move by its rounding error.
+    const __m256 e = exp(_mm256_sub_ps(_mm256_mul_ps(_mm256_maskload_ps(scores + j, mask), s), shift));
+    _mm256_maskstore_ps(scores + j, mask, e);
+    vsum = _mm256_add_ps(vsum, _mm256_and_ps(e, _mm256_castsi256_ps(mask)));
+  }
+  const float factor =
+      old_max == -INFINITY ? 0.0f : _mm256_cvtss_f32(exp(_mm256_set1_ps(old_max - new_max)));
+  *running_sum = *running_sum * factor + horizontal_sum(vsum);
+  *running_max = new_max;
+  return factor;
+}
+
+void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
+                  const float* wx, int out_w, int c, float* out) {
+  const __m256 vy = _mm256_set1_ps(wy);
+  for (int x = 0; x < out_w; ++x) {
+    const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;
+    const float *b0 = bottom + int64_t{x0[x]} * c, *b1 = bottom + int64_t{x1[x]} * c;
+    float* o = out + int64_t{x} * c;
+    const __m256 vx = _mm256_set1_ps(wx[x]);
+    for (int ch = 0; ch < c; ch += 8) {
+      const __m256i mask = tail_mask(c - ch);
+      const __m256 t0v = _mm256_maskload_ps(t0 + ch, mask), b0v = _mm256_maskload_ps(b0 + ch, mask);
+      const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_maskload_ps(t1 + ch, mask), t0v), t0v);
+      const __m256 b = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_maskload_ps(b1 + ch, mask), b0v), b0v);
+      _mm256_maskstore_ps(o + ch, mask, _mm256_fmadd_ps(vy, _mm256_sub_ps(b, t), t));
+    }
+  }
+}
+
+}  // namespace ampi::avx2
