@@ -11,7 +11,7 @@ packages=(
   python3-pil                               # JPEG decoding of the photos (training/photo_folder.py)
   g++-aarch64-linux-gnu qemu-user           # aarch64 cross build, tests run under qemu
   debootstrap                               # the arm64 sysroot of the whole program (scripts/arm64_sysroot.sh)
-  ffmpeg                                    # GIF output (palette) and H.264 through OpenCV
+  ffmpeg                                    # GIF output (palette) and the MP4s (x264 held to bounded memory)
   clang libclang-rt-14-dev                  # libFuzzer targets (fuzz/, scripts/test_reliability.sh)
   chromium                                  # headless screenshots of viewer.html in the tests
 )

@@ -1,6 +1,8 @@
 // AVX2 transformer row kernels (contracts in kernels/kernel_list.def). Tails go through
 // masked loads and stores, so every element takes the vector path and no scalar helper
-// from a shared header is compiled with AVX2 flags (cmake/isa.cmake).
+// from a shared header is compiled with AVX2 flags (cmake/isa.cmake); whole vectors use
+// plain ones, as vmaskmovps stores are slow on AMD's cores (measured: softmax 3x slower
+// with every store masked).
 #include <cmath>
 
 #include "kernels/x86/avx2_channels.h"
@@ -58,10 +60,14 @@ float squared_deviations(const float* in, int c, float mean) {
 
 void layer_norm_row(const float* in, int c, const float* gamma, const float* beta, float eps, float* out) {
   const float mean = row_sum(in, c) / static_cast<float>(c);
-  const __m256 inv_std = _mm256_div_ps(
-      _mm256_set1_ps(1.0f), _mm256_sqrt_ps(_mm256_set1_ps(squared_deviations(in, c, mean) / static_cast<float>(c) + eps)));
+  const __m256 inv_std = _mm256_set1_ps(1.0f / std::sqrt(squared_deviations(in, c, mean) / static_cast<float>(c) + eps));
   const __m256 m = _mm256_set1_ps(mean);
-  for (int i = 0; i < c; i += 8) {
+  int i = 0;
+  for (; i + 8 <= c; i += 8) {
+    const __m256 d = _mm256_mul_ps(_mm256_sub_ps(_mm256_loadu_ps(in + i), m), inv_std);
+    _mm256_storeu_ps(out + i, _mm256_fmadd_ps(d, _mm256_loadu_ps(gamma + i), _mm256_loadu_ps(beta + i)));
+  }
+  if (i < c) {
     const __m256i mask = tail_mask(c - i);
     const __m256 d = _mm256_mul_ps(_mm256_sub_ps(_mm256_maskload_ps(in + i, mask), m), inv_std);
     _mm256_maskstore_ps(out + i, mask,
@@ -82,10 +88,14 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   // As the reference: a block whose every score is -inf contributes nothing, not NaN.
   const __m256 shift = _mm256_set1_ps(new_max == -INFINITY ? 0.0f : new_max);
   __m256 vsum = _mm256_setzero_ps();
-  for (int j = 0; j < n; j += 8) {
+  int j = 0;
+  for (; j + 8 <= n; j += 8) {
+    const __m256 e = exp(_mm256_sub_ps(_mm256_mul_ps(_mm256_loadu_ps(scores + j), s), shift));
+    _mm256_storeu_ps(scores + j, e);
+    vsum = _mm256_add_ps(vsum, e);
+  }
+  if (j < n) {
     const __m256i mask = tail_mask(n - j);
-    // Multiply, then subtract (not one FMA): the reference rounds s * scale first, and an
-    // exponent near the maximum must not move by its rounding error.
     const __m256 e = exp(_mm256_sub_ps(_mm256_mul_ps(_mm256_maskload_ps(scores + j, mask), s), shift));
     _mm256_maskstore_ps(scores + j, mask, e);
     vsum = _mm256_add_ps(vsum, _mm256_and_ps(e, _mm256_castsi256_ps(mask)));
@@ -97,15 +107,53 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   return factor;
 }
 
+namespace {
+
+// One channel (a depth map resized to the photo): 8 output columns a vector, their 4 taps
+// gathered; masked-off lanes gather column 0, which every row has.
+__m256 bilinear_columns(const float* top, const float* bottom, __m256 vy, __m256i i0, __m256i i1, __m256 vx) {
+  const __m256 t0 = _mm256_i32gather_ps(top, i0, 4), t1 = _mm256_i32gather_ps(top, i1, 4);
+  const __m256 b0 = _mm256_i32gather_ps(bottom, i0, 4), b1 = _mm256_i32gather_ps(bottom, i1, 4);
+  const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(t1, t0), t0);
+  const __m256 b = _mm256_fmadd_ps(vx, _mm256_sub_ps(b1, b0), b0);
+  return _mm256_fmadd_ps(vy, _mm256_sub_ps(b, t), t);
+}
+
+void bilinear_row_one_channel(const float* top, const float* bottom, float wy, const int32_t* x0,
+                              const int32_t* x1, const float* wx, int out_w, float* out) {
+  const __m256 vy = _mm256_set1_ps(wy);
+  int x = 0;
+  for (; x + 8 <= out_w; x += 8) {
+    const __m256i i0 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(x0 + x));
+    const __m256i i1 = _mm256_loadu_si256(reinterpret_cast<const __m256i*>(x1 + x));
+    _mm256_storeu_ps(out + x, bilinear_columns(top, bottom, vy, i0, i1, _mm256_loadu_ps(wx + x)));
+  }
+  if (x < out_w) {
+    const __m256i mask = tail_mask(out_w - x);
+    const __m256i i0 = _mm256_maskload_epi32(x0 + x, mask), i1 = _mm256_maskload_epi32(x1 + x, mask);
+    _mm256_maskstore_ps(out + x, mask, bilinear_columns(top, bottom, vy, i0, i1, _mm256_maskload_ps(wx + x, mask)));
+  }
+}
+
+}  // namespace
+
 void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
                   const float* wx, int out_w, int c, float* out) {
+  if (c == 1) return bilinear_row_one_channel(top, bottom, wy, x0, x1, wx, out_w, out);
   const __m256 vy = _mm256_set1_ps(wy);
   for (int x = 0; x < out_w; ++x) {
     const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;
     const float *b0 = bottom + int64_t{x0[x]} * c, *b1 = bottom + int64_t{x1[x]} * c;
     float* o = out + int64_t{x} * c;
     const __m256 vx = _mm256_set1_ps(wx[x]);
-    for (int ch = 0; ch < c; ch += 8) {
+    int ch = 0;
+    for (; ch + 8 <= c; ch += 8) {
+      const __m256 t0v = _mm256_loadu_ps(t0 + ch), b0v = _mm256_loadu_ps(b0 + ch);
+      const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_loadu_ps(t1 + ch), t0v), t0v);
+      const __m256 b = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_loadu_ps(b1 + ch), b0v), b0v);
+      _mm256_storeu_ps(o + ch, _mm256_fmadd_ps(vy, _mm256_sub_ps(b, t), t));
+    }
+    if (ch < c) {
       const __m256i mask = tail_mask(c - ch);
       const __m256 t0v = _mm256_maskload_ps(t0 + ch, mask), b0v = _mm256_maskload_ps(b0 + ch, mask);
       const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_maskload_ps(t1 + ch, mask), t0v), t0v);

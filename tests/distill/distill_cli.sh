@@ -54,6 +54,12 @@ grep -q "3 photos labelled (2 by earlier runs)" "$tmp/log" || fail "second run: 
 [ "$(grep -c 'ampi distill: \[' "$tmp/log")" = 1 ] || fail "second run labelled more than c.jpg: $(cat "$tmp/log")"
 [ "$(md5sum "$tmp/labels/a.png")" = "$first" ] || fail "a.png changed on resuming"
 
+# A Depth Anything V2 teacher runs each square at its own working size.
+"$ampi" distill --teacher "$src/tests/fixtures/nets/dav2_tiny.ampw" --images "$tmp/photos" -o "$tmp/dav2" \
+  --resolutions 28,42 --threads 2 >"$tmp/log" 2>&1 || fail "dav2 teacher: $(cat "$tmp/log")"
+[ "$(png_header "$tmp/dav2/sub_b.png")" = "45 61 16 0" ] || fail "dav2 sub_b.png: header $(png_header "$tmp/dav2/sub_b.png")"
+grep -q "^resolutions	28,42$" "$tmp/dav2/labels.tsv" || fail "dav2 labels.tsv lacks the resolutions"
+
 # Refusals: one line, non-zero exit, the folder unchanged.
 before=$(ls -l "$tmp/labels" | md5sum)
 expect_error() {
