@@ -30,9 +30,8 @@ constexpr float kOneSixth = 1.0f / 6.0f;
 
 // e^x by the vector exp's own steps (exp_polynomials.h): GELU's reference must evaluate
 // the formula the vector code does, so the two agree within a few ulp. The rounding and
-// the 2^n are done in float bits, as the vector code does them: std::nearbyint and
-// std::ldexp are library calls on the baseline target, and they made the scalar GELU
-// several times slower.
+// the 2^n are done in float bits, as the vector code does them, rather than through
+// std::nearbyint and std::ldexp, library calls on the baseline x86-64 target.
 inline float exp_polynomial(float x) {
   using namespace exp_poly;
   x = std::min(std::max(x, kMin), kMax);
