@@ -5,16 +5,17 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/tensor.h"
+
 namespace ampi {
 namespace {
 
 [[noreturn]] void fail(const std::string& what) { throw std::runtime_error(what); }
 
-// Queries per attention task and keys per streamed block: a task's scores (128 x 256
-// floats, 128 KiB) stay in L2 between the two products. Each task packs every block of K
-// and V for itself, so fewer, taller tasks pack less: at ViT-S 518 x 518 (1,370 tokens)
-// 64 queries took about 12% more CPU time than 128, and 256 no less than 128.
-constexpr int kQueryBlock = 128;
+// Queries per attention task and keys per streamed block: a task's scores (64 x 256
+// floats, 64 KiB) stay in L2 between the two products, and a head of ViT-S at 518 x 518
+// (1,370 tokens) makes 22 tasks, enough to keep the threads evenly busy.
+constexpr int kQueryBlock = 64;
 constexpr int kKeyBlock = 256;
 
 // PyTorch's cubic convolution kernel, a = -0.75: `near` for |t| <= 1, `far` for 1 < |t| < 2.
@@ -180,55 +181,80 @@ void self_attention(const float* qkv, int tokens, int dim, int heads, float scal
                     int64_t out_stride, ThreadPool& pool, const KernelTable& k) {
   if (tokens <= 0 || heads <= 0 || dim <= 0 || dim % heads || out_stride < dim)
     fail("self_attention: bad sizes (dim must split into the heads)");
-  const int head_dim = dim / heads;
+  const int head_dim = dim / heads, nr = k.gemm_nr;
   const int64_t row = 3 * int64_t(dim);
+  const int key_blocks = (tokens + kKeyBlock - 1) / kKeyBlock;
   const int query_blocks = (tokens + kQueryBlock - 1) / kQueryBlock;
-  // One task per head and block of queries; its products run on the calling thread (a
-  // nested loop of the pool runs inline), so the split never depends on the thread count.
-  pool.parallel_for(int64_t(heads) * query_blocks, 1, [&](int64_t u0, int64_t u1) {
-    std::vector<float> scores(size_t(kQueryBlock) * kKeyBlock);
-    float running_max[kQueryBlock], running_sum[kQueryBlock];
-    for (int64_t u = u0; u < u1; ++u) {
-      const int head = int(u / query_blocks), q0 = int(u % query_blocks) * kQueryBlock;
-      const int qn = std::min(kQueryBlock, tokens - q0);
-      const float* q = qkv + q0 * row + head * head_dim;
-      float* o = out + q0 * out_stride + head * head_dim;
-      std::fill(running_max, running_max + qn, -INFINITY);
-      std::fill(running_sum, running_sum + qn, 0.0f);
-      for (int k0 = 0; k0 < tokens; k0 += kKeyBlock) {
-        const int kn = std::min(kKeyBlock, tokens - k0);
-        GemmProblem s;  // scores = Q K^T of this block of keys
-        s.m = qn;
-        s.n = kn;
-        s.k = head_dim;
-        s.a = q;
-        s.a_stride = row;
-        s.c = scores.data();
-        s.c_stride = kKeyBlock;
-        gemm(s, StridedMatrix{qkv + k0 * row + dim + head * head_dim, row, true}, nullptr, pool, k);
-        for (int r = 0; r < qn; ++r) {
-          const float factor =
-              k.softmax_block_row(&scores[size_t(r) * kKeyBlock], kn, scale, &running_max[r], &running_sum[r]);
-          if (k0 > 0)
-            for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= factor;
+  const auto keys_in = [&](int block) { return std::min(kKeyBlock, tokens - block * kKeyBlock); };
+  // One head's K^T and V, packed once per block of keys (entry 2b: K^T of block b, a
+  // head_dim x keys B; entry 2b + 1: V, keys x head_dim) and read by every query task:
+  // memory linear in tokens, each starting on a 64-byte line.
+  std::vector<int64_t> offset(2 * key_blocks + 1, 0);
+  for (int b = 0; b < key_blocks; ++b) {
+    offset[2 * b + 1] = offset[2 * b] + (gemm_packed_size(keys_in(b), head_dim, nr) + 15) / 16 * 16;
+    offset[2 * b + 2] = offset[2 * b + 1] + (gemm_packed_size(head_dim, keys_in(b), nr) + 15) / 16 * 16;
+  }
+  const AlignedBuffer buffer = aligned_alloc64(size_t(offset.back()) * sizeof(float));
+  float* packed = static_cast<float*>(buffer.get());
+  for (int head = 0; head < heads; ++head) {
+    const float* q = qkv + head * head_dim;
+    pool.parallel_for(2 * int64_t(key_blocks), 1, [&](int64_t i0, int64_t i1) {
+      for (int64_t i = i0; i < i1; ++i) {
+        const int b = int(i / 2), kn = keys_in(b);
+        const float* keys = q + int64_t(b) * kKeyBlock * row + dim;
+        if (i % 2 == 0)
+          pack_gemm_panels(StridedMatrix{keys, row, true}, nullptr, kn, head_dim, nr, 0, (kn + nr - 1) / nr,
+                           packed + offset[i]);
+        else
+          pack_gemm_panels(StridedMatrix{keys + dim, row, false}, nullptr, head_dim, kn, nr, 0,
+                           (head_dim + nr - 1) / nr, packed + offset[i]);
+      }
+    });
+    // One task per block of queries; its products run on the calling thread (a nested
+    // loop of the pool runs inline), so the split never depends on the thread count.
+    pool.parallel_for(query_blocks, 1, [&](int64_t u0, int64_t u1) {
+      std::vector<float> scores(size_t(kQueryBlock) * kKeyBlock);
+      float running_max[kQueryBlock], running_sum[kQueryBlock];
+      for (int64_t u = u0; u < u1; ++u) {
+        const int q0 = int(u) * kQueryBlock, qn = std::min(kQueryBlock, tokens - q0);
+        float* o = out + q0 * out_stride + head * head_dim;
+        std::fill(running_max, running_max + qn, -INFINITY);
+        std::fill(running_sum, running_sum + qn, 0.0f);
+        for (int b = 0; b < key_blocks; ++b) {
+          const int kn = keys_in(b);
+          GemmProblem s;  // scores = Q K^T of this block of keys
+          s.m = qn;
+          s.n = kn;
+          s.k = head_dim;
+          s.a = q + q0 * row;
+          s.a_stride = row;
+          s.c = scores.data();
+          s.c_stride = kKeyBlock;
+          gemm_packed(s, packed + offset[2 * b], pool, k);
+          for (int r = 0; r < qn; ++r) {
+            const float factor =
+                k.softmax_block_row(&scores[size_t(r) * kKeyBlock], kn, scale, &running_max[r], &running_sum[r]);
+            if (b > 0)
+              for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= factor;
+          }
+          GemmProblem pv;  // out += P V of this block (the first block writes out)
+          pv.m = qn;
+          pv.n = head_dim;
+          pv.k = kn;
+          pv.a = scores.data();
+          pv.a_stride = kKeyBlock;
+          pv.c = o;
+          pv.c_stride = out_stride;
+          pv.residual = b > 0 ? o : nullptr;
+          gemm_packed(pv, packed + offset[2 * b + 1], pool, k);
         }
-        GemmProblem pv;  // out += P V of this block (the first block writes out)
-        pv.m = qn;
-        pv.n = head_dim;
-        pv.k = kn;
-        pv.a = scores.data();
-        pv.a_stride = kKeyBlock;
-        pv.c = o;
-        pv.c_stride = out_stride;
-        pv.residual = k0 > 0 ? o : nullptr;
-        gemm(pv, StridedMatrix{qkv + k0 * row + 2 * dim + head * head_dim, row, false}, nullptr, pool, k);
+        for (int r = 0; r < qn; ++r) {
+          const float inv = 1.0f / running_sum[r];
+          for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= inv;
+        }
       }
-      for (int r = 0; r < qn; ++r) {
-        const float inv = 1.0f / running_sum[r];
-        for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= inv;
-      }
-    }
-  });
+    });
+  }
 }
 
 // ---- transposed convolution -------------------------------------------------------------
