@@ -3,6 +3,8 @@
 #pragma once
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 
 #include "kernels/exp_polynomials.h"
 
@@ -27,15 +29,24 @@ Activation parse_activation(const char* name);
 constexpr float kOneSixth = 1.0f / 6.0f;
 
 // e^x by the vector exp's own steps (exp_polynomials.h): GELU's reference must evaluate
-// the formula the vector code does, so the two agree within a few ulp.
+// the formula the vector code does, so the two agree within a few ulp. The rounding and
+// the 2^n are done in float bits, as the vector code does them, rather than through
+// std::nearbyint and std::ldexp, library calls on the baseline x86-64 target.
 inline float exp_polynomial(float x) {
   using namespace exp_poly;
   x = std::min(std::max(x, kMin), kMax);
-  const float n = std::nearbyint(x * kLog2e);
+  // Adding and subtracting 1.5 * 2^23 rounds to the nearest integer (ties to even) for
+  // |v| < 2^22; here |v| < 128.
+  constexpr float kRoundingShift = 12582912.0f;
+  const float n = (x * kLog2e + kRoundingShift) - kRoundingShift;
   const float r = (x - n * kLn2Hi) - n * kLn2Lo;
   float p = kExp[0];
   for (size_t i = 1; i < sizeof(kExp) / sizeof(kExp[0]); ++i) p = p * r + kExp[i];
-  return std::ldexp(p * (r * r) + (r + 1.0f), static_cast<int>(n));
+  // 2^n for n in [-126, 127]: the exponent field alone.
+  const uint32_t bits = static_cast<uint32_t>(static_cast<int32_t>(n) + 127) << 23;
+  float two_to_n;
+  std::memcpy(&two_to_n, &bits, sizeof two_to_n);
+  return (p * (r * r) + (r + 1.0f)) * two_to_n;
 }
 
 // gelu(x) = x Phi(x), Phi the standard normal CDF. Both signs go through the tail

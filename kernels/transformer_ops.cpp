@@ -5,16 +5,17 @@
 #include <stdexcept>
 #include <string>
 
+#include "engine/tensor.h"
+
 namespace ampi {
 namespace {
 
 [[noreturn]] void fail(const std::string& what) { throw std::runtime_error(what); }
 
-// Queries per attention task and keys per streamed block: a task's scores (128 x 256
-// floats, 128 KiB) stay in L2 between the two products. Each task packs every block of K
-// and V for itself, so fewer, taller tasks pack less: at ViT-S 518 x 518 (1,370 tokens)
-// 64 queries took about 12% more CPU time than 128, and 256 no less than 128.
-constexpr int kQueryBlock = 128;
+// Queries per attention task and keys per streamed block: a task's scores (64 x 256
+// floats, 64 KiB) stay in L2 between the two products, and ViT-S at 518 x 518 (1,370
+// tokens, 6 heads) makes 132 tasks, enough to keep the threads evenly busy.
+constexpr int kQueryBlock = 64;
 constexpr int kKeyBlock = 256;
 
 // PyTorch's cubic convolution kernel, a = -0.75: `near` for |t| <= 1, `far` for 1 < |t| < 2.
@@ -176,57 +177,110 @@ void PatchEmbedding::run(const float* image, int h, int w, float* out, int64_t o
   gemm(p, weights_, pool);
 }
 
+namespace {
+
+// Where every head's K and V live once packed: per head, per block of keys b, entry 2b
+// (K^T of the block, a head_dim x keys B) then 2b + 1 (V, keys x head_dim), each on a
+// 64-byte line. Memory linear in tokens: about the size of K and V themselves.
+struct PackedKeysValues {
+  int tokens = 0, head_dim = 0, blocks = 0;
+  std::vector<int64_t> offset;  // [2 * blocks + 1] floats into one head's share
+  AlignedBuffer buffer;
+
+  int keys_in(int block) const { return std::min(kKeyBlock, tokens - block * kKeyBlock); }
+  const float* at(int head, int entry) const {
+    return static_cast<const float*>(buffer.get()) + head * offset.back() + offset[entry];
+  }
+};
+
+PackedKeysValues pack_keys_values(const float* qkv, int tokens, int dim, int heads, ThreadPool& pool,
+                                  const KernelTable& k) {
+  PackedKeysValues kv;
+  kv.tokens = tokens;
+  kv.head_dim = dim / heads;
+  kv.blocks = (tokens + kKeyBlock - 1) / kKeyBlock;
+  const int nr = k.gemm_nr, head_dim = kv.head_dim;
+  const auto lines = [](int64_t floats) { return (floats + 15) / 16 * 16; };
+  kv.offset.assign(2 * kv.blocks + 1, 0);
+  for (int b = 0; b < kv.blocks; ++b) {
+    kv.offset[2 * b + 1] = kv.offset[2 * b] + lines(gemm_packed_size(kv.keys_in(b), head_dim, nr));
+    kv.offset[2 * b + 2] = kv.offset[2 * b + 1] + lines(gemm_packed_size(head_dim, kv.keys_in(b), nr));
+  }
+  kv.buffer = aligned_alloc64(size_t(heads) * kv.offset.back() * sizeof(float));
+  const int64_t row = 3 * int64_t(dim), entries = 2 * int64_t(kv.blocks);
+  pool.parallel_for(heads * entries, 1, [&](int64_t i0, int64_t i1) {
+    for (int64_t i = i0; i < i1; ++i) {
+      const int head = int(i / entries), entry = int(i % entries), b = entry / 2, kn = kv.keys_in(b);
+      const float* keys = qkv + int64_t(b) * kKeyBlock * row + dim + head * head_dim;
+      float* dst = const_cast<float*>(kv.at(head, entry));
+      if (entry % 2 == 0)
+        pack_gemm_panels(StridedMatrix{keys, row, true}, nullptr, kn, head_dim, nr, 0, (kn + nr - 1) / nr, dst);
+      else
+        pack_gemm_panels(StridedMatrix{keys + dim, row, false}, nullptr, head_dim, kn, nr, 0,
+                         (head_dim + nr - 1) / nr, dst);
+    }
+  });
+  return kv;
+}
+
+// out rows [q0, q0 + qn) of one head: softmax(scale q k^T) v, streamed over the blocks of
+// keys. scores holds kQueryBlock x kKeyBlock floats.
+void attend(const float* q, int64_t q_stride, int qn, const PackedKeysValues& kv, int head, float scale,
+            float* o, int64_t out_stride, float* scores, ThreadPool& pool, const KernelTable& k) {
+  float running_max[kQueryBlock], running_sum[kQueryBlock];
+  std::fill(running_max, running_max + qn, -INFINITY);
+  std::fill(running_sum, running_sum + qn, 0.0f);
+  for (int b = 0; b < kv.blocks; ++b) {
+    const int kn = kv.keys_in(b);
+    GemmProblem s;  // scores = Q K^T of this block of keys
+    s.m = qn;
+    s.n = kn;
+    s.k = kv.head_dim;
+    s.a = q;
+    s.a_stride = q_stride;
+    s.c = scores;
+    s.c_stride = kKeyBlock;
+    gemm_packed(s, kv.at(head, 2 * b), pool, k);
+    for (int r = 0; r < qn; ++r) {
+      const float factor = k.softmax_block_row(scores + size_t(r) * kKeyBlock, kn, scale, &running_max[r],
+                                               &running_sum[r]);
+      if (b > 0)
+        for (int j = 0; j < kv.head_dim; ++j) o[r * out_stride + j] *= factor;
+    }
+    GemmProblem pv;  // out += P V of this block (the first block writes out)
+    pv.m = qn;
+    pv.n = kv.head_dim;
+    pv.k = kn;
+    pv.a = scores;
+    pv.a_stride = kKeyBlock;
+    pv.c = o;
+    pv.c_stride = out_stride;
+    pv.residual = b > 0 ? o : nullptr;
+    gemm_packed(pv, kv.at(head, 2 * b + 1), pool, k);
+  }
+  for (int r = 0; r < qn; ++r) {
+    const float inv = 1.0f / running_sum[r];
+    for (int j = 0; j < kv.head_dim; ++j) o[r * out_stride + j] *= inv;
+  }
+}
+
+}  // namespace
+
 void self_attention(const float* qkv, int tokens, int dim, int heads, float scale, float* out,
                     int64_t out_stride, ThreadPool& pool, const KernelTable& k) {
   if (tokens <= 0 || heads <= 0 || dim <= 0 || dim % heads || out_stride < dim)
     fail("self_attention: bad sizes (dim must split into the heads)");
-  const int head_dim = dim / heads;
+  const PackedKeysValues kv = pack_keys_values(qkv, tokens, dim, heads, pool, k);
   const int64_t row = 3 * int64_t(dim);
   const int query_blocks = (tokens + kQueryBlock - 1) / kQueryBlock;
   // One task per head and block of queries; its products run on the calling thread (a
   // nested loop of the pool runs inline), so the split never depends on the thread count.
   pool.parallel_for(int64_t(heads) * query_blocks, 1, [&](int64_t u0, int64_t u1) {
     std::vector<float> scores(size_t(kQueryBlock) * kKeyBlock);
-    float running_max[kQueryBlock], running_sum[kQueryBlock];
     for (int64_t u = u0; u < u1; ++u) {
       const int head = int(u / query_blocks), q0 = int(u % query_blocks) * kQueryBlock;
-      const int qn = std::min(kQueryBlock, tokens - q0);
-      const float* q = qkv + q0 * row + head * head_dim;
-      float* o = out + q0 * out_stride + head * head_dim;
-      std::fill(running_max, running_max + qn, -INFINITY);
-      std::fill(running_sum, running_sum + qn, 0.0f);
-      for (int k0 = 0; k0 < tokens; k0 += kKeyBlock) {
-        const int kn = std::min(kKeyBlock, tokens - k0);
-        GemmProblem s;  // scores = Q K^T of this block of keys
-        s.m = qn;
-        s.n = kn;
-        s.k = head_dim;
-        s.a = q;
-        s.a_stride = row;
-        s.c = scores.data();
-        s.c_stride = kKeyBlock;
-        gemm(s, StridedMatrix{qkv + k0 * row + dim + head * head_dim, row, true}, nullptr, pool, k);
-        for (int r = 0; r < qn; ++r) {
-          const float factor =
-              k.softmax_block_row(&scores[size_t(r) * kKeyBlock], kn, scale, &running_max[r], &running_sum[r]);
-          if (k0 > 0)
-            for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= factor;
-        }
-        GemmProblem pv;  // out += P V of this block (the first block writes out)
-        pv.m = qn;
-        pv.n = head_dim;
-        pv.k = kn;
-        pv.a = scores.data();
-        pv.a_stride = kKeyBlock;
-        pv.c = o;
-        pv.c_stride = out_stride;
-        pv.residual = k0 > 0 ? o : nullptr;
-        gemm(pv, StridedMatrix{qkv + k0 * row + 2 * dim + head * head_dim, row, false}, nullptr, pool, k);
-      }
-      for (int r = 0; r < qn; ++r) {
-        const float inv = 1.0f / running_sum[r];
-        for (int j = 0; j < head_dim; ++j) o[r * out_stride + j] *= inv;
-      }
+      attend(qkv + q0 * row + head * kv.head_dim, row, std::min(kQueryBlock, tokens - q0), kv, head, scale,
+             out + q0 * out_stride + head * kv.head_dim, out_stride, scores.data(), pool, k);
     }
   });
 }

@@ -23,6 +23,7 @@ struct RowMap {
   __m256 row_x, row_y, row_w;  // the terms constant along the row
   __m256 max_u, max_v;
   __m256i stride;
+  __m256i stored_x, stored_y, stored_width, stored_height;
 };
 
 RowMap row_map(const PlaneView& plane, const InverseHomography& h, int y) {
@@ -39,6 +40,10 @@ RowMap row_map(const PlaneView& plane, const InverseHomography& h, int y) {
   r.max_u = _mm256_set1_ps(static_cast<float>(plane.width));
   r.max_v = _mm256_set1_ps(static_cast<float>(plane.height));
   r.stride = _mm256_set1_epi32(static_cast<int32_t>(plane.stride));
+  r.stored_x = _mm256_set1_epi32(plane.stored_x);
+  r.stored_y = _mm256_set1_epi32(plane.stored_y);
+  r.stored_width = _mm256_set1_epi32(plane.stored_width);
+  r.stored_height = _mm256_set1_epi32(plane.stored_height);
   return r;
 }
 
@@ -60,8 +65,13 @@ Footprints locate(const RowMap& r, int x) {
   Footprints f;
   f.ax = _mm256_sub_ps(u, fu);
   f.ay = _mm256_sub_ps(v, fv);
-  const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(_mm256_cvttps_epi32(fv), r.stride),
-                                         _mm256_cvttps_epi32(fu));
+  // The stored block's column and row, clamped to [-2, stored size] (composite_kernels.h).
+  const __m256i before = _mm256_set1_epi32(-2);
+  const __m256i column = _mm256_min_epi32(
+      _mm256_max_epi32(_mm256_sub_epi32(_mm256_cvttps_epi32(fu), r.stored_x), before), r.stored_width);
+  const __m256i row = _mm256_min_epi32(
+      _mm256_max_epi32(_mm256_sub_epi32(_mm256_cvttps_epi32(fv), r.stored_y), before), r.stored_height);
+  const __m256i index = _mm256_add_epi32(_mm256_mullo_epi32(row, r.stride), column);
   _mm256_store_si256(reinterpret_cast<__m256i*>(f.top_left), index);
   return f;
 }

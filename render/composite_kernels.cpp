@@ -13,15 +13,20 @@ ShiftSpan shift_span(const PlaneView& plane, float du, float dv, int y, int x_be
   const float v = static_cast<float>(y) + dv;
   if (!(v >= -1.0f && v <= static_cast<float>(plane.height)) || !std::isfinite(du)) return span;
   const float fv = std::floor(v), fu = std::floor(du);
-  // Pixel x's footprint starts at column x + fu: it must lie in [-1, width].
-  const double first = std::max<double>(x_begin, -1.0 - fu);
-  const double last = std::min<double>(x_begin + count - 1.0, plane.width - static_cast<double>(fu));
+  // Rows fv and fv + 1 both outside the stored block: only its transparent border.
+  const int row = static_cast<int>(fv) - plane.stored_y;
+  if (row < -1 || row > plane.stored_height) return span;
+  // Pixel x's footprint starts at stored column x + fu - stored_x: it must lie in
+  // [-1, stored_width] (within the layer's [-1, width], as the block is in the layer).
+  const double offset = static_cast<double>(fu) - plane.stored_x;
+  const double first = std::max<double>(x_begin, -1.0 - offset);
+  const double last = std::min<double>(x_begin + count - 1.0, plane.stored_width - offset);
   if (first > last) return span;
   span.empty = false;
   span.first = static_cast<int>(first);
   span.last = static_cast<int>(last);
-  span.column_offset = static_cast<int>(fu);  // within [-1 - last, width - first]: no overflow
-  span.row = static_cast<int>(fv);
+  span.column_offset = static_cast<int>(offset);  // within [-1 - last, stored_width - first]: no overflow
+  span.row = row;
   span.ax = du - fu;
   span.ay = v - fv;
   return span;

@@ -11,15 +11,26 @@
 
 namespace ampi::render {
 
-// A premultiplied layer as the kernels read it: BGRA half floats in [0, 1], with a zero
-// border of one pixel on the left and top and two on the right and bottom, so a bilinear
-// footprint whose coordinates are clamped to [-1, width] x [-1, height] is always inside
-// the buffer and reads transparent pixels outside the layer (no edge branches).
+// A premultiplied layer as the kernels read it: BGRA half floats in [0, 1]. Only a block
+// of it is stored, the rest being transparent (zero): the whole layer, or the box around
+// its visible pixels, which at 4K is about half of the frame. The block has a zero border
+// of two pixels on the right and bottom, and of one on the left and top (two when the
+// block starts inside the layer). Coordinates are clamped to [-1, width] x [-1, height]
+// as for the whole layer, then the footprint's stored column and row to [-2, stored
+// width] and [-2, stored height]: a footprint outside the block reads only its border,
+// transparent as the layer is there, so a frame is the same bit for bit whatever block is
+// stored (no edge branches).
 struct PlaneView {
-  const uint16_t* origin = nullptr;  // layer pixel (0, 0): 4 halves per pixel
-  int64_t stride = 0;                // pixels between rows of the padded buffer
+  const uint16_t* origin = nullptr;  // the block's pixel (0, 0): 4 halves per pixel
+  int64_t stride = 0;                // pixels between rows of the padded block
   int width = 0, height = 0;         // the layer's size (without the border)
+  int stored_x = 0, stored_y = 0;    // where the block starts in the layer
+  int stored_width = 0, stored_height = 0;  // the block's size (without the border)
 };
+// A view of a whole stored layer.
+inline PlaneView whole_layer_view(const uint16_t* origin, int64_t stride, int width, int height) {
+  return {origin, stride, width, height, 0, 0, width, height};
+}
 
 // Row-major 3x3 map from new-view pixels to layer pixels (the inverse plane homography),
 // pixel centres at integer coordinates.
@@ -43,8 +54,8 @@ using ShiftOverRowFn = void (*)(const PlaneView& plane, float du, float dv, int 
                                 int count, float* accum);
 // Where a translated row reads the layer. Output pixels x in [first, last] read columns
 // x + column_offset and x + column_offset + 1 of rows `row` and `row` + 1 of the padded
-// layer, with the weights ax (right) and ay (below); the row's other pixels read only the
-// transparent border and are left alone. Empty when nothing is read.
+// stored block, with the weights ax (right) and ay (below); the row's other pixels read
+// only the transparent border and are left alone. Empty when nothing is read.
 struct ShiftSpan {
   bool empty = true;
   int first = 0, last = -1;

@@ -21,6 +21,7 @@ struct RowMap {
   float32x4_t row_x, row_y, row_w;  // the terms constant along the row
   float32x4_t max_u, max_v;
   int32x4_t stride;
+  int32x4_t stored_x, stored_y, stored_width, stored_height;
 };
 
 RowMap row_map(const PlaneView& plane, const InverseHomography& h, int y) {
@@ -36,6 +37,10 @@ RowMap row_map(const PlaneView& plane, const InverseHomography& h, int y) {
   r.max_u = vdupq_n_f32(static_cast<float>(plane.width));
   r.max_v = vdupq_n_f32(static_cast<float>(plane.height));
   r.stride = vdupq_n_s32(static_cast<int32_t>(plane.stride));
+  r.stored_x = vdupq_n_s32(plane.stored_x);
+  r.stored_y = vdupq_n_s32(plane.stored_y);
+  r.stored_width = vdupq_n_s32(plane.stored_width);
+  r.stored_height = vdupq_n_s32(plane.stored_height);
   return r;
 }
 
@@ -57,7 +62,12 @@ Footprints locate(const RowMap& r, int x) {
   Footprints f;
   vst1q_f32(f.ax, vsubq_f32(u, fu));
   vst1q_f32(f.ay, vsubq_f32(v, fv));
-  vst1q_s32(f.top_left, vmlaq_s32(vcvtq_s32_f32(fu), vcvtq_s32_f32(fv), r.stride));
+  // The stored block's column and row, clamped to [-2, stored size] (composite_kernels.h).
+  const int32x4_t before = vdupq_n_s32(-2);
+  const int32x4_t column =
+      vminq_s32(vmaxq_s32(vsubq_s32(vcvtq_s32_f32(fu), r.stored_x), before), r.stored_width);
+  const int32x4_t row = vminq_s32(vmaxq_s32(vsubq_s32(vcvtq_s32_f32(fv), r.stored_y), before), r.stored_height);
+  vst1q_s32(f.top_left, vmlaq_s32(column, row, r.stride));
   return f;
 }
 

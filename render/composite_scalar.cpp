@@ -20,11 +20,19 @@ Bgra load_pixel(const uint16_t* p) {
 // Clamps a layer coordinate to [-1, hi]; NaN (a degenerate homography) goes to -1.
 float clamp_to_border(float c, float hi) { return c >= -1.0f ? std::min(c, hi) : -1.0f; }
 
+// The stored block's column (or row) of a footprint starting at layer column `layer`:
+// clamped to [-2, stored], where a footprint reads only the block's transparent border.
+int64_t stored_index(float layer, int start, int stored) {
+  return std::min<int64_t>(std::max<int64_t>(static_cast<int64_t>(layer) - start, -2), stored);
+}
+
 // Bilinear sample of the padded layer at (u, v), already clamped to [-1, w] x [-1, h].
 Bgra sample(const PlaneView& plane, float u, float v) {
   const float fu = std::floor(u), fv = std::floor(v);
   const float ax = u - fu, ay = v - fv;
-  const uint16_t* top = plane.origin + 4 * (static_cast<int64_t>(fv) * plane.stride + static_cast<int64_t>(fu));
+  const int64_t column = stored_index(fu, plane.stored_x, plane.stored_width);
+  const int64_t row = stored_index(fv, plane.stored_y, plane.stored_height);
+  const uint16_t* top = plane.origin + 4 * (row * plane.stride + column);
   const uint16_t* bottom = top + 4 * plane.stride;
   const Bgra tl = load_pixel(top), tr = load_pixel(top + 4);
   const Bgra bl = load_pixel(bottom), br = load_pixel(bottom + 4);

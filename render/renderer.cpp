@@ -10,9 +10,10 @@
 namespace ampi {
 namespace {
 
-// Padding of the half-float planes: one transparent pixel before each row and column,
-// two after (the bilinear footprint of a coordinate clamped to the far edge).
-constexpr int kPadBefore = 1;
+// Padding of the stored half-float blocks: two transparent pixels before each row and
+// column (a footprint left of a block that starts inside the layer) and two after (the
+// bilinear footprint of a coordinate clamped to the far edge).
+constexpr int kPadBefore = 2;
 constexpr int kPadAfter = 2;
 
 // Straight-alpha BGRA bytes to premultiplied BGRA floats in [0, 1].
@@ -118,17 +119,46 @@ Renderer::Coverage Renderer::coverage_of(const cv::Mat& bgra) {
   return c;
 }
 
+// The box around a layer's visible pixels (alpha > 0); empty when none is.
+cv::Rect Renderer::visible_box(const cv::Mat& bgra) {
+  int x0 = bgra.cols, y0 = bgra.rows, x1 = 0, y1 = 0;  // x1, y1 exclusive
+  for (int y = 0; y < bgra.rows; ++y) {
+    const uint8_t* p = bgra.ptr<uint8_t>(y);
+    int first = -1, last = -1;
+    for (int x = 0; x < bgra.cols; ++x)
+      if (p[4 * x + 3]) {
+        if (first < 0) first = x;
+        last = x;
+      }
+    if (first < 0) continue;
+    x0 = std::min(x0, first);
+    x1 = std::max(x1, last + 1);
+    y0 = std::min(y0, y);
+    y1 = y + 1;
+  }
+  return x1 > x0 ? cv::Rect(x0, y0, x1 - x0, y1 - y0) : cv::Rect();
+}
+
+// Only the box around the visible pixels is stored: outside it the layer is transparent,
+// which the kernels read from the box's border (composite_kernels.h).
 Renderer::Layer Renderer::prepare_layer(const cv::Mat& bgra, double depth) {
   Layer layer;
   layer.depth = depth;
-  layer.padded = cv::Mat(bgra.rows + kPadBefore + kPadAfter, bgra.cols + kPadBefore + kPadAfter,
-                         CV_16FC4, cv::Scalar::all(0));
-  cv::Mat inside = layer.padded(cv::Rect(kPadBefore, kPadBefore, bgra.cols, bgra.rows));
-  premultiply_to_half(bgra, inside);
-  layer.view.origin = reinterpret_cast<const uint16_t*>(inside.data);
+  const cv::Rect box = visible_box(bgra);
+  layer.padded = cv::Mat(box.height + kPadBefore + kPadAfter, box.width + kPadBefore + kPadAfter, CV_16FC4,
+                         cv::Scalar::all(0));
+  if (!box.empty()) {
+    cv::Mat inside = layer.padded(cv::Rect(kPadBefore, kPadBefore, box.width, box.height));
+    premultiply_to_half(bgra(box), inside);
+  }
+  layer.view.origin = layer.padded.ptr<uint16_t>(kPadBefore) + 4 * kPadBefore;
   layer.view.stride = static_cast<int64_t>(layer.padded.step1() / 4);
   layer.view.width = bgra.cols;
   layer.view.height = bgra.rows;
+  layer.view.stored_x = box.x;
+  layer.view.stored_y = box.y;
+  layer.view.stored_width = box.width;
+  layer.view.stored_height = box.height;
   layer.coverage = coverage_of(bgra);
   return layer;
 }

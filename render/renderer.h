@@ -1,7 +1,9 @@
 // Novel views of an MPI. Each layer is premultiplied once into a padded half-float BGRA
-// plane; a frame is split into tiles that the thread pool renders independently: for
-// every tile, each plane whose warped footprint can reach the tile is sampled through its
-// inverse homography (bilinear) and composited back to front with the *over* operator.
+// block, the box around its visible pixels (about half of the frame for the layers of a
+// 4K photo; the rest is transparent and not stored); a frame is split into tiles that
+// the thread pool renders independently: for every tile, each plane whose warped
+// footprint can reach the tile is sampled through its inverse homography (bilinear) and
+// composited back to front with the *over* operator.
 // Planes behind one that is opaque over the whole tile are skipped: over an opaque sample
 // the accumulator is multiplied by exactly zero, so the frame is the same bit for bit.
 #pragma once
@@ -53,7 +55,9 @@ class Renderer {
     bool all_opaque(const cv::Rect& pixels) const;
   };
   struct Layer {
-    cv::Mat padded;  // CV_16FC4 premultiplied BGRA with the border PlaneView describes
+    // CV_16FC4 premultiplied BGRA: the box around the visible pixels only, with the
+    // border PlaneView describes
+    cv::Mat padded;
     render::PlaneView view;
     double depth = 0;
     Coverage coverage;
@@ -69,6 +73,7 @@ class Renderer {
   // or opaque pixels only (the planes behind it are hidden there).
   enum class TileCover { None, Partial, Opaque };
 
+  static cv::Rect visible_box(const cv::Mat& bgra);
   static Layer prepare_layer(const cv::Mat& bgra, double depth);
   void check_setup(const Mpi& mpi) const;
   static Coverage coverage_of(const cv::Mat& bgra);

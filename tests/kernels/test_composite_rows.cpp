@@ -40,7 +40,30 @@ struct PaddedPlane {
         uint16_t* p = &pixels[4 * ((static_cast<size_t>(y) + 1) * (width + 3) + x + 1)];
         for (int k = 0; k < 4; ++k) p[k] = float_to_half(k == 3 ? v[3] : v[k] * v[3]);
       }
-    view = {pixels.data() + 4 * (width + 3 + 1), width + 3, width, height};
+    view = render::whole_layer_view(pixels.data() + 4 * (width + 3 + 1), width + 3, width, height);
+  }
+};
+
+// A layer visible only inside a box, twice: stored whole (the layout of PaddedPlane) and
+// stored as the box alone with its border of two pixels, as the renderer stores it.
+struct BoxedPlane {
+  std::vector<uint16_t> whole_pixels, box_pixels;
+  render::PlaneView whole, box;
+
+  BoxedPlane(int width, int height, int box_x, int box_y, int box_width, int box_height, uint32_t seed)
+      : whole_pixels(static_cast<size_t>(4) * (width + 3) * (height + 3), 0),
+        box_pixels(static_cast<size_t>(4) * (box_width + 4) * (box_height + 4), 0) {
+    const auto values = test::random_floats(static_cast<size_t>(4) * box_width * box_height, seed, 0.0f, 1.0f);
+    for (int y = 0; y < box_height; ++y)
+      for (int x = 0; x < box_width; ++x) {
+        const float* v = &values[4 * (static_cast<size_t>(y) * box_width + x)];
+        uint16_t* w = &whole_pixels[4 * ((static_cast<size_t>(box_y + y) + 1) * (width + 3) + box_x + x + 1)];
+        uint16_t* b = &box_pixels[4 * ((static_cast<size_t>(y) + 2) * (box_width + 4) + x + 2)];
+        for (int k = 0; k < 4; ++k) w[k] = b[k] = float_to_half(k == 3 ? v[3] : v[k] * v[3]);
+      }
+    whole = render::whole_layer_view(whole_pixels.data() + 4 * (width + 3 + 1), width + 3, width, height);
+    box = {box_pixels.data() + 4 * (2 * (box_width + 4) + 2), box_width + 4, width, height,
+           box_x, box_y, box_width, box_height};
   }
 };
 
@@ -91,7 +114,7 @@ TEST_CASE("every compositor kernel matches the scalar reference") {
         const float v = values[4 * (y * width + x) + k];
         padded[4 * ((y + 1) * (width + 3) + x + 1) + k] = float_to_half(k == 3 ? alpha : v * alpha);
       }
-  render::PlaneView plane{padded.data() + 4 * (width + 3 + 1), width + 3, width, height};
+  const render::PlaneView plane = render::whole_layer_view(padded.data() + 4 * (width + 3 + 1), width + 3, width, height);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> jitter(-1.0f, 1.0f);
   const render::CompositeKernels reference = render::composite_kernels(Isa::Scalar);
@@ -133,7 +156,7 @@ TEST_CASE("every translation kernel matches the scalar reference") {
         const size_t at = 4 * ((y + 1) * (width + 3) + x + 1) + k;
         padded[at] = float_to_half(k == 3 ? values[at - k + 3] : values[at] * values[at - k + 3]);
       }
-  const render::PlaneView plane{padded.data() + 4 * (width + 3 + 1), width + 3, width, height};
+  const render::PlaneView plane = render::whole_layer_view(padded.data() + 4 * (width + 3 + 1), width + 3, width, height);
   std::mt19937 rng(seed);
   std::uniform_real_distribution<float> shift(-45.0f, 45.0f);
   const render::CompositeKernels reference = render::composite_kernels(Isa::Scalar);
@@ -238,6 +261,51 @@ TEST_CASE("every accum_to_bgr variant equals the scalar reference bit for bit on
       accum_to_bgr(accum.data(), count, got.data());
       INFO("isa " << isa_name(isa) << ", count " << count << ", seed " << seed);
       REQUIRE(got == expected);
+    }
+  }
+}
+
+TEST_CASE("a layer stored as the box around its visible pixels composites as the whole layer, bit for bit") {
+  // Boxes touching each edge of the layer, inside it, the whole layer, one pixel, none.
+  struct Box {
+    int x, y, width, height;
+  };
+  const int width = 17, height = 9;
+  for (Isa isa : runnable_isas()) {
+    const render::CompositeKernels k = render::composite_kernels(isa);
+    for (const Box& b : {Box{0, 0, 17, 9}, Box{0, 0, 5, 3}, Box{12, 6, 5, 3}, Box{3, 2, 9, 4}, Box{8, 4, 1, 1},
+                         Box{1, 0, 16, 9}, Box{0, 1, 17, 8}, Box{5, 5, 0, 0}}) {
+      const uint32_t seed = static_cast<uint32_t>(31 * b.x + 7 * b.y + b.width + 100 * b.height);
+      const BoxedPlane plane(width, height, b.x, b.y, b.width, b.height, seed);
+      std::mt19937 rng(seed);
+      int map_index = 0;
+      for (const render::InverseHomography& h : sweep_maps(width, height, rng)) {
+        for (int y : {-2, 0, b.y, b.y + b.height, height / 2, height, height + 1})
+          for (int count : kCounts) {
+            const int x_begin = (map_index + count) % 5 - 2;
+            INFO("isa " << isa_name(isa) << ", box " << b.width << "x" << b.height << " at " << b.x << "," << b.y
+                        << ", seed " << seed << ", map " << map_index << ", y " << y << ", count " << count);
+            const auto start = test::random_floats(4 * count, seed + count, 0.0f, 1.0f);
+            std::vector<float> expected = start, got = start;
+            k.warp_over_row(plane.whole, h, y, x_begin, count, expected.data());
+            k.warp_over_row(plane.box, h, y, x_begin, count, got.data());
+            REQUIRE(test::max_abs_diff(expected.data(), got.data(), expected.size()) == 0.0f);
+          }
+        ++map_index;
+      }
+      const std::vector<float> du_sweep = sweep_shifts(width, rng), dv_sweep = sweep_shifts(height, rng);
+      for (float du : du_sweep)
+        for (float dv : dv_sweep)
+          for (int count : kCounts) {
+            const int x_begin = count % 3 - 1, y = (count + height) % (height + 2) - 1;
+            INFO("isa " << isa_name(isa) << ", box " << b.width << "x" << b.height << " at " << b.x << "," << b.y
+                        << ", seed " << seed << ", du " << du << ", dv " << dv << ", y " << y << ", count " << count);
+            const auto start = test::random_floats(4 * count, seed + count, 0.0f, 1.0f);
+            std::vector<float> expected = start, got = start;
+            k.shift_over_row(plane.whole, du, dv, y, x_begin, count, expected.data());
+            k.shift_over_row(plane.box, du, dv, y, x_begin, count, got.data());
+            REQUIRE(test::max_abs_diff(expected.data(), got.data(), expected.size()) == 0.0f);
+          }
     }
   }
 }

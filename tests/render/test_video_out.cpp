@@ -134,6 +134,24 @@ TEST_CASE("an MP4 given up on leaves nothing behind and stops its encoder") {
   CHECK(entries(dir.path()).empty());
 }
 
+TEST_CASE("an ffmpeg that fails while encoding gives one error naming the video and leaves nothing") {
+  test::TempDir programs, dir;
+  // Passes the libx264 probe, fails on the real work without reading its input.
+  const std::string fake = programs.write("ffmpeg", "#!/bin/sh\ncase \"$*\" in *lavfi*) exit 0 ;; esac\nexit 3\n");
+  fs::permissions(fake, fs::perms::owner_all);
+  ScopedPath only_fake(programs.path().string());
+  const std::string path = dir.file("broken.mp4");
+  auto encode = [&] {
+    FrameWriter w(path, Container::Mp4, 30, false);
+    for (int k = 0; k < 10; ++k) w.add(test_frame(k, {640, 480}));
+    w.finish();
+  };
+  // Which of the two errors depends on whether the pipe still took the frames.
+  CHECK_THROWS_WITH(encode(), Catch::Contains(path) && Catch::Contains("ffmpeg") &&
+                                  (Catch::Contains("stopped while encoding") || Catch::Contains("exit status 3")));
+  CHECK(entries(dir.path()).empty());
+}
+
 TEST_CASE("GIFs are made by ffmpeg, or refused up front with the reason") {
   test::TempDir dir;
   {
