@@ -26,10 +26,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Multiples of 14 (the ViT's patch) around Depth Anything V2's own 518; five sides times
-// the mirror image make the paper's ten predictions. Chosen so a 1024x768 photo takes at
-// most 30 s on 2 threads with ViT-S (README, "A stronger depth model").
-#define DEFAULT_RESOLUTIONS "266,350,434,518,602"
+// Five sides times the mirror image make the paper's ten predictions. The paper spread
+// MiDaS over 512..1920 px; a ViT's attention grows with the square of its tokens, so
+// these go from Depth Anything V2's own 518 up to about a 1024-px photo's size, in
+// multiples of its 14-px patch: one 1024x768 photo costs ViT-S about 25 s of CPU here,
+// within 30 s on 2 threads (README, "A stronger depth model", has the measurement).
+#define DEFAULT_RESOLUTIONS "518,644,770,896,1022"
 
 const char kUsage[] =
     "usage: ampi distill --teacher FILE.ampw --images DIR -o LABELS\n"
