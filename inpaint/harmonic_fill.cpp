@@ -130,6 +130,7 @@ std::vector<Level> cascade_levels(const cv::Mat& colour, const cv::Mat& known, i
   cv::threshold(weight, weight, 0.0, 1.0, cv::THRESH_BINARY);
   cv::merge(std::vector<cv::Mat>(3, weight), weight3);
   weighted = colour.mul(weight3);
+  weight3.release();  // a full-size image no longer needed: the levels below are smaller
   while (std::max(levels.back().colour.cols, levels.back().colour.rows) > coarsest_side) {
     const cv::Size half((levels.back().colour.cols + 1) / 2, (levels.back().colour.rows + 1) / 2);
     cv::resize(weight, weight, half, 0, 0, cv::INTER_AREA);
@@ -190,15 +191,20 @@ cv::Mat harmonic_estimate(const cv::Mat& image, const cv::Mat& known, const Harm
   else
     bgr = image;
   bgr.convertTo(colour, CV_32F);
-  const std::vector<Level> levels = cascade_levels(colour, known, params.coarsest_side);
+  bgr.release();
+  std::vector<Level> levels = cascade_levels(colour, known, params.coarsest_side);
+  colour.release();  // levels[0] holds it
   cv::Mat estimate = coarsest_start(levels, params.start_side);
   relax(estimate, levels.back().known, params.coarsest_sweeps, params.omega, 0, pool);
   for (size_t l = levels.size() - 1; l-- > 0;) {
     // the coarser solution, brought up, starts the unknown pixels of this level
     cv::Mat up;
     cv::resize(estimate, up, levels[l].colour.size(), 0, 0, cv::INTER_LINEAR);
-    estimate = levels[l].colour.clone();
+    // The level's colours are read only here: the estimate takes them over (at the full
+    // size of a 4K layer, 100 MB not copied).
+    estimate = std::move(levels[l].colour);
     up.copyTo(estimate, levels[l].known == 0);
+    up.release();
     relax(estimate, levels[l].known, params.sweeps, params.omega, params.band, pool);
   }
   return estimate;

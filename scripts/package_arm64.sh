@@ -4,7 +4,10 @@
 # (defaults build-aarch64 and build-aarch64-sysroot, as scripts/test.sh makes them).
 # The package holds /usr/bin/ampi and the bundled weights in /usr/share/ampi/weights (where
 # an installed ampi looks, nets/bundled_weights.h) and depends on Debian 12's arm64
-# OpenCV runtime libraries, the only libraries ampi links besides the C and C++ runtimes:
+# OpenCV runtime libraries, the only libraries ampi links besides the C and C++ runtimes.
+# It recommends the ffmpeg program, which apt installs by default: ampi pipes its MP4s to
+# it with x264's memory bounded (render/video_out.h); OpenCV's own writer, used without
+# it, lets x264 take about 1.5 GB at 4K, too much for a 2 GB board:
 #   sudo apt install ./ampi_VERSION_arm64.deb
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -33,6 +36,7 @@ Version: $version
 Architecture: arm64
 Maintainer: ampi developers
 Depends: $(IFS=,; echo "${depends[*]}" | sed 's/,/, /g')
+Recommends: ffmpeg
 Installed-Size: $(du -sk "$stage/usr" | cut -f1)
 Section: graphics
 Priority: optional

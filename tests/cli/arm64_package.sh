@@ -13,6 +13,7 @@ for file in usr/bin/ampi usr/share/ampi/weights/depth_lite.ampw usr/share/ampi/w
   [ -f "$tmp/root/$file" ] || { echo "$deb: no /$file" >&2; exit 1; }
 done
 dpkg-deb -f "$deb" Depends | grep -q "libopencv-core" || { echo "$deb: Depends names no OpenCV" >&2; exit 1; }
+dpkg-deb -f "$deb" Recommends | grep -qw "ffmpeg" || { echo "$deb: Recommends lacks ffmpeg (bounded-memory MP4s)" >&2; exit 1; }
 unset AMPI_WEIGHTS_DIR
 qemu-aarch64 -L "$sysroot" "$tmp/root/usr/bin/ampi" depth tests/fixtures/slicing/three_levels.png \
   -o "$tmp/depth.png" --threads 2 >/dev/null
