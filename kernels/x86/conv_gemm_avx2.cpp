@@ -2,6 +2,11 @@
 // vectors and one broadcast fill 15 of the 16 ymm registers, and 12 independent FMA
 // chains cover the FMA latency (4 cycles) on two FMA ports. A panel whose last columns
 // fit in one vector runs a 6x8 tile instead of multiplying zeros.
+// Outputs larger than the last-level cache keep plain stores (GemmArgs::stream_c is
+// ignored): streaming them as the AVX-512 tile does measured slower on AMD Zen 4 with
+// 256-bit stores, 1x1 16->64 at 512x384 4.95 -> 5.17 ms (cpu clock, 1 thread, medians
+// of alternating runs). Splitting the 6x8 tile's k over two accumulator sets (12 chains
+// instead of 6) measured no better on 1x1 96->24 (2.53 -> 2.52 ms).
 #include <algorithm>
 
 #include "kernels/conv_epilogue.h"
@@ -51,16 +56,20 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
       for (int v = 0; v < kVectors; ++v) acc[r][v] = _mm256_fmadd_ps(av, bv[v], acc[r][v]);
     }
   }
-  // Unrolled, so every acc index is a constant and the accumulators live in registers
-  // only (a runtime row loop here makes GCC mirror them to the stack in the k loop).
+  // Unrolled, so every acc index is a constant, and each row copied out before the
+  // activation takes it by reference: the accumulators then live in registers only (a
+  // runtime row loop, or activating acc[r] itself, makes GCC mirror all 12 to the stack
+  // on every k step, 12 stores beside the 12 FMAs).
 #pragma GCC unroll 16
   for (int r = 0; r < kGemmMr; ++r) {
     if (r >= m) continue;
-    activate_tile(acc[r], g.act, [](__m256 x, ActivationSpec a) { return activate(x, a); });
+    __m256 out[kVectors];
+    for (int v = 0; v < kVectors; ++v) out[v] = acc[r][v];
+    activate_tile(out, g.act, [](__m256 x, ActivationSpec a) { return activate(x, a); });
     float* c = g.c + r * g.c_stride + j0;
     const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
     for (int v = 0; v < kVectors; ++v)
-      store_columns(acc[r][v], c + 8 * v, res ? res + 8 * v : nullptr, columns - 8 * v);
+      store_columns(out[v], c + 8 * v, res ? res + 8 * v : nullptr, columns - 8 * v);
   }
 }
 
