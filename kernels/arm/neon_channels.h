@@ -69,6 +69,14 @@ inline void copy_floats(const float* src, int64_t n, float* dst) {
 // bench/arm_model.py's 3x3 s1 loop went from 69 to 62 cycles on Neoverse-N1.
 constexpr bool kStepColumns = true;
 
+// Depthwise interior blocks keep a kernel of up to this many weight vectors in registers
+// across blocks (depthwise_lanes.inl): 3x3's 9, beside a block's 8 accumulators and the
+// column being read, fit NEON's 32 registers; 5x5's 25 do not. bench/arm_model.py's 3x3 s1
+// loop went from 62 to 53 cycles on Neoverse-N1 (262 -> 154 instructions): the rest over
+// the 40-cycle FMA bound is the accumulators' copies of the bias (fmla overwrites its
+// addend) and the stores, which share the two vector pipes with the FMAs.
+constexpr int kDepthwiseWeightRegisters = 16;
+
 // Nothing to do here: avx512_channels.h says why AVX-512 pins loaded vectors.
 template <class V>
 inline void keep_in_register(V&) {}
