@@ -148,7 +148,7 @@ template <bool kStream, int K, int S, class Act, class Lane>
   V w[K][K];
   for (int ky = 0; ky < K; ++ky)
     for (int kx = 0; kx < K; ++kx) w[ky][kx] = lane.load(d.weights + (static_cast<int64_t>(ky) * K + kx) * c + ch);
-  const V bias = lane.load(d.bias + ch);
+  const float* bias = d.bias + ch;
   const int64_t first_column = static_cast<int64_t>(first * S - d.pad_left) * c + ch;
   const float* rows[K];  // block p's first column in each kernel row; null: a padding row
   for (int ky = 0; ky < K; ++ky) rows[ky] = d.in_rows[ky] ? d.in_rows[ky] + first_column : nullptr;
@@ -162,7 +162,8 @@ template <bool kStream, int K, int S, class Act, class Lane>
   const float* residual = d.residual ? d.residual + static_cast<int64_t>(first) * c + ch : nullptr;
   for (int p = first; p < end; p += kBlock) {
     V acc[kBlock];
-    for (int i = 0; i < kBlock; ++i) acc[i] = bias;
+    // Each accumulator from its own load of the bias (load_again, each ISA's *_channels.h).
+    for (int i = 0; i < kBlock; ++i) acc[i] = lane.load_again(bias);
 #pragma GCC unroll 8
     for (int ky = 0; ky < K; ++ky) {
       if (!rows[ky]) continue;
