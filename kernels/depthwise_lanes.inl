@@ -182,7 +182,8 @@ template <bool kStream, int K, int S, class Act, class Lane>
     }
     for (int i = 0; i < kBlock; ++i) {
       V v = act(acc[i]);
-      if (residual) v = plus(v, lane.load(residual + i * c));
+      // Rounded before the residual is added, as in block() (opaque, each ISA's *_channels.h).
+      if (residual) v = plus(opaque(v), lane.load(residual + i * c));
       if constexpr (kStream)
         lane.stream(out + i * c, v);
       else

@@ -87,6 +87,16 @@ constexpr bool kStepColumns = true;
 // FMA bound is the stores, whose data also goes through the two vector pipes.
 constexpr int kDepthwiseWeightRegisters = 16;
 
+// v as a value GCC cannot look into: it may not fuse the multiply that made v with an add
+// of v into one FMA. The depthwise interior with its weights held (depthwise_lanes.inl)
+// adds the residual after the activation; without this GCC fused HardSwish's last
+// multiply into that add there, while the other depthwise paths round between them.
+template <class V>
+inline V opaque(V v) {
+  asm("" : "+w"(v));
+  return v;
+}
+
 // Nothing to do here: avx512_channels.h says why AVX-512 pins loaded vectors.
 template <class V>
 inline void keep_in_register(V&) {}
