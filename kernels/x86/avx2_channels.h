@@ -87,12 +87,12 @@ inline float horizontal_sum(__m256 v) {
 // 16 registers, stepping made 5x5 s1 over 256x192x96 slower (3.9-4.2 -> 5.0-6.1 ms).
 constexpr bool kStepColumns = false;
 
-// Depthwise interior blocks reload their weights each block (depthwise_lanes.inl): 0 keeps
-// no kernel in registers across blocks.
-constexpr int kDepthwiseWeightRegisters = 0;
-
 // Nothing to do here: avx512_channels.h says why AVX-512 pins loaded vectors.
 template <class V>
 inline void keep_in_register(V&) {}
+
+// Depthwise interior blocks reload their weights each block (depthwise_lanes.inl): 0 keeps
+// no kernel in registers across blocks.
+constexpr int kDepthwiseWeightRegisters = 0;
 
 }  // namespace ampi::avx2
