@@ -17,6 +17,10 @@
 // - With dilation 1 and the common kernel widths (3, 5) and strides (1, 2) fixed at
 //   compile time, each input column of a block is loaded once and feeds every
 //   (pixel, tap) pair that reads it: 10 loads for 24 FMAs per kernel row (3x3, stride 1).
+// - Where the whole kernel fits in registers beside a block (kDepthwiseWeightRegisters:
+//   NEON's 32 registers hold a 3x3 kernel's 9), the interior keeps it there across a
+//   channel vector's blocks and steps one pointer per kernel row from block to block;
+//   x86 reloads the weights per block (its 16 registers on AVX2; AVX-512 was not tried).
 // - Blocks whose taps all fall inside the row load without bounds checks; the few
 //   border blocks (and the last, shorter one) load a zero for a column outside the row
 //   and store only their valid pixels, so the borders run the same vector code instead
