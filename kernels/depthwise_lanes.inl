@@ -17,6 +17,10 @@
 // - With dilation 1 and the common kernel widths (3, 5) and strides (1, 2) fixed at
 //   compile time, each input column of a block is loaded once and feeds every
 //   (pixel, tap) pair that reads it: 10 loads for 24 FMAs per kernel row (3x3, stride 1).
+// - Where the whole kernel fits in registers beside a block (kDepthwiseWeightRegisters:
+//   NEON's 32 registers hold a 3x3 kernel's 9), the interior keeps it there across a
+//   channel vector's blocks and steps one pointer per kernel row from block to block;
+//   x86 reloads the weights per block (its 16 registers on AVX2; AVX-512 was not tried).
 // - Blocks whose taps all fall inside the row load without bounds checks; the few
 //   border blocks (and the last, shorter one) load a zero for a column outside the row
 //   and store only their valid pixels, so the borders run the same vector code instead
@@ -134,6 +138,71 @@ template <bool kChecked, bool kStream, class Geometry, class Act, class Lane>
   }
 }
 
+// The interior blocks [first, end) of one channel vector with the whole K x K kernel
+// held in registers (kDepthwiseWeightRegisters, each ISA's *_channels.h), loaded once
+// instead of once per block, and one column pointer per kernel row stepping from block
+// to block instead of recomputed from the row, the block and the channel each time.
+// The FMAs run in the same order as accumulate()'s, so the sums are the same bits.
+template <bool kStream, int K, int S, class Act, class Lane>
+[[gnu::always_inline]] inline void interior_with_weights_held(const DepthwiseRowArgs& d, FixedGeometry<K, S>,
+                                                              Act act, int first, int end, int ch, Lane lane) {
+  using V = decltype(lane.load(d.bias));
+  constexpr int kColumns = (kBlock - 1) * S + K;
+  const int64_t c = d.channels;
+  V w[K][K];
+  for (int ky = 0; ky < K; ++ky)
+    for (int kx = 0; kx < K; ++kx) w[ky][kx] = lane.load(d.weights + (static_cast<int64_t>(ky) * K + kx) * c + ch);
+  const float* bias = d.bias + ch;
+  const int64_t first_column = static_cast<int64_t>(first * S - d.pad_left) * c + ch;
+  const float* rows[K];  // block p's first column in each kernel row; null: a padding row
+  for (int ky = 0; ky < K; ++ky) rows[ky] = d.in_rows[ky] ? d.in_rows[ky] + first_column : nullptr;
+  const int64_t block_step = static_cast<int64_t>(kBlock) * S * c;
+  // Column j of a block at rows[ky] + column_offset[j]: one load with a register offset,
+  // no address arithmetic per column.
+  int64_t column_offset[kColumns];
+  for (int j = 0; j < kColumns; ++j) column_offset[j] = j * c;
+  // The output and residual through locals: the stores may alias d.
+  float* out = d.out + static_cast<int64_t>(first) * c + ch;
+  const float* residual = d.residual ? d.residual + static_cast<int64_t>(first) * c + ch : nullptr;
+  for (int p = first; p < end; p += kBlock) {
+    V acc[kBlock];
+    // Each accumulator from its own load of the bias (load_again, each ISA's *_channels.h).
+    for (int i = 0; i < kBlock; ++i) acc[i] = lane.load_again(bias);
+#pragma GCC unroll 8
+    for (int ky = 0; ky < K; ++ky) {
+      if (!rows[ky]) continue;
+      const float* row = rows[ky];
+      rows[ky] += block_step;
+#pragma GCC unroll 32
+      for (int j = 0; j < kColumns; ++j) {
+        const V x = lane.load(row + column_offset[j]);
+#pragma GCC unroll 8
+        for (int kx = 0; kx < K; ++kx) {
+          const int offset = j - kx;  // as in accumulate()
+          if (offset >= 0 && offset % S == 0 && offset / S < kBlock)
+            acc[offset / S] = fmadd(w[ky][kx], x, acc[offset / S]);
+        }
+      }
+    }
+    for (int i = 0; i < kBlock; ++i) {
+      V v = act(acc[i]);
+      // Rounded before the residual is added, as in block() (opaque, each ISA's *_channels.h).
+      if (residual) v = plus(opaque(v), lane.load(residual + i * c));
+      if constexpr (kStream)
+        lane.stream(out + i * c, v);
+      else
+        lane.store(out + i * c, v);
+    }
+    out += kBlock * c;
+    if (residual) residual += kBlock * c;
+  }
+}
+
+template <class Geometry>
+constexpr bool weights_fit_in_registers(Geometry) { return false; }
+template <int K, int S>
+constexpr bool weights_fit_in_registers(FixedGeometry<K, S>) { return K * K <= kDepthwiseWeightRegisters; }
+
 // The input row the next output row reads first, at the columns of block ox: one
 // prefetch per 64-byte line.
 inline void prefetch_next_row(const DepthwiseRowArgs& d, int ox) {
@@ -170,7 +239,10 @@ void blocks(const DepthwiseRowArgs& args, Act act) {
   // The interior channel vector by channel vector (see the top).
   for (int p = interior_first; p < interior_end; p += kBlock) prefetch_next_row(d, p);
   channels.each([&](int ch, auto lane) {
-    for (int p = interior_first; p < interior_end; p += kBlock) block<false, kStream>(d, g, act, p, kBlock, ch, lane);
+    if constexpr (!weights_fit_in_registers(Geometry{}))
+      for (int p = interior_first; p < interior_end; p += kBlock) block<false, kStream>(d, g, act, p, kBlock, ch, lane);
+    else
+      interior_with_weights_held<kStream>(d, g, act, interior_first, interior_end, ch, lane);
   });
   for (ox = std::max(ox, interior_end); ox < d.out_w; ox += kBlock) border_block(ox);
 }

@@ -17,6 +17,15 @@ struct Vector {
   // Plain stores: a 16-byte vector is a quarter of a line, too little to stream.
   static void stream(float* p, float32x4_t v) { vst1q_f32(p, v); }
   static float32x4_t splat(float x) { return vdupq_n_f32(x); }
+  // A load the compiler may not merge with an earlier one of the same address: each of a
+  // block's accumulators starts from its own load of the bias, not from a copy of one
+  // register (fmla overwrites its addend, so each copy is a vector move, and the moves
+  // take the vector pipes the FMAs need while the load pipes have room).
+  static float32x4_t load_again(const float* p) {
+    float32x4_t v;
+    asm volatile("ldr %q0, [%1]" : "=w"(v) : "r"(p), "m"(*reinterpret_cast<const float(*)[4]>(p)));
+    return v;
+  }
 };
 
 struct Scalar {
@@ -24,6 +33,7 @@ struct Scalar {
   static void store(float* p, float v) { *p = v; }
   static void stream(float* p, float v) { *p = v; }
   static float splat(float x) { return x; }
+  static float load_again(const float* p) { return *p; }
 };
 
 inline void finish_streaming() {}
@@ -68,6 +78,24 @@ inline void copy_floats(const float* src, int64_t n, float* dst) {
 // Depthwise interior columns through a stepping pointer (avx512_channels.h says why):
 // bench/arm_model.py's 3x3 s1 loop went from 69 to 62 cycles on Neoverse-N1.
 constexpr bool kStepColumns = true;
+
+// Depthwise interior blocks keep a kernel of up to this many weight vectors in registers
+// across blocks (depthwise_lanes.inl): 3x3's 9, beside a block's 8 accumulators and the
+// column being read, fit NEON's 32 registers; 5x5's 25 do not. bench/arm_model.py's 3x3 s1
+// loop went from 62 to 53 cycles on Neoverse-N1 (262 -> 154 instructions), and to 48 with
+// the bias loaded into each accumulator (Vector::load_again); the rest over the 40-cycle
+// FMA bound is the stores, whose data also goes through the two vector pipes.
+constexpr int kDepthwiseWeightRegisters = 16;
+
+// v as a value GCC cannot look into: it may not fuse the multiply that made v with an add
+// of v into one FMA. The depthwise interior with its weights held (depthwise_lanes.inl)
+// adds the residual after the activation; without this GCC fused HardSwish's last
+// multiply into that add there, while the other depthwise paths round between them.
+template <class V>
+inline V opaque(V v) {
+  asm("" : "+w"(v));
+  return v;
+}
 
 // Nothing to do here: avx512_channels.h says why AVX-512 pins loaded vectors.
 template <class V>

@@ -93,4 +93,8 @@ constexpr bool kStepColumns = false;
 template <class V>
 inline void keep_in_register(V&) {}
 
+// Depthwise interior blocks reload their weights each block (depthwise_lanes.inl): 0 keeps
+// no kernel in registers across blocks.
+constexpr int kDepthwiseWeightRegisters = 0;
+
 }  // namespace ampi::avx2

@@ -46,6 +46,10 @@ inline void keep_in_register(V& v) { asm("" : "+v"(v)); }
 // alternating runs), the other depthwise rows unchanged within noise.
 constexpr bool kStepColumns = true;
 
+// Depthwise interior blocks reload their weights each block (depthwise_lanes.inl): 0 keeps
+// no kernel in registers across blocks.
+constexpr int kDepthwiseWeightRegisters = 0;
+
 class Channels {
  public:
   explicit Channels(int c)
