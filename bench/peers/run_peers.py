@@ -452,6 +452,13 @@ def load_raw(args, path: Path):
     return cases, raw["seconds"]
 
 
+def vit_sizes_note(args) -> str:
+    """` --vit-sizes ...` when the run had Depth Anything V2 rows, else nothing."""
+    if not any(m in VIT_VARIANTS for m in args.models.split(",")):
+        return ""
+    return f" --vit-sizes {args.vit_sizes}"
+
+
 def write_results(args, cases, seconds: float):
     v = versions(cases)
     padded = [c for c in cases if tuple(c["padded"]) != tuple(c["size"])]
@@ -466,10 +473,11 @@ def write_results(args, cases, seconds: float):
         "# Peer benchmark: ampi's depth network beside ONNX Runtime, OpenCV DNN and PyTorch", "",
         "Made by `bash bench/peers/run.sh` (bench/peers/README.md) in one run of "
         f"{seconds / 60:.1f} minutes (wall clock, waits included) at commit {args.commit}, with "
-        f"`--models {args.models} --sizes {args.sizes} --threads {','.join(map(str, args.threads))} "
+        f"`--models {args.models} --sizes {args.sizes}{vit_sizes_note(args)} "
+        f"--threads {','.join(map(str, args.threads))} "
         f"--warmup {args.warmup} --rounds {args.rounds}`{wrap_note(args)}; rerun it to refresh this file.", "",
         f"- Machine: {cpu_model()}, {os.cpu_count()} cores; ampi's kernels: {v['isa']}.",
-        "- Engines, all on the CPU, the same thread count each (1, then 2):",
+        f"- Engines, all on the CPU, the same thread count each ({', then '.join(map(str, args.threads))}):",
         "  ampi (`ampi bench network`, DepthModel::run on its own kernels);",
         f"  ONNX Runtime {v['ort']} (npm's onnxruntime-node, CPU provider, all graph optimisations, "
         "intra-op threads = T, inter-op 1);",
