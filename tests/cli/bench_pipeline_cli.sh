@@ -7,14 +7,7 @@
 set -u
 ampi=$1
 photo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 "$ampi" bench pipeline --photo "$photo" --sizes 96x64 --runs 1 --frames 3 --inpainter push-pull \
   --out "$tmp/table.md" >"$tmp/stdout" 2>"$tmp/err" || fail "exit $?: $(cat "$tmp/err")"

@@ -5,14 +5,7 @@
 set -u
 ampi=$1
 good=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 # expect_error NAME FILE TEXT: non-zero exit, one stderr line naming FILE and containing TEXT.
 expect_error() {

@@ -6,14 +6,7 @@
 set -u
 ampi=$1
 photo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 # expect_error NAME PHOTO TEXT
 expect_error() {

@@ -8,14 +8,7 @@ set -u
 ampi=$1
 src=$2
 teacher="$src/tests/fixtures/nets/tiny_depth.ampw"
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 # png_header FILE: "width height bit_depth colour_type" from the IHDR chunk.
 png_header() {

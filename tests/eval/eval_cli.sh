@@ -9,14 +9,7 @@
 set -u
 ampi=$1
 photo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 # expect_error NAME TEXT ARGS...: non-zero exit, nothing on stdout, one stderr line with TEXT.
 expect_error() {

@@ -6,15 +6,8 @@
 set -u
 ampi=$1
 photo=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+. "$(dirname "$0")/../support/cli_checks.sh"
 echo "not an image" >"$tmp/text.jpg"
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
 
 # png_header FILE: "width height bit_depth colour_type" from the IHDR chunk.
 png_header() {

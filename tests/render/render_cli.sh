@@ -5,13 +5,7 @@
 set -u
 ampi=$1
 mpi=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-fail() {
-  echo "render_cli: FAILED: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 # expect_error NEEDLE ARGS...: the command fails with one line on stderr containing NEEDLE.
 expect_error() {

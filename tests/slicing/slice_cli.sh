@@ -6,14 +6,7 @@
 set -u
 ampi=$1
 depth=$2
-tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
-failures=0
-
-fail() {
-  echo "FAIL: $*" >&2
-  failures=$((failures + 1))
-}
+. "$(dirname "$0")/../support/cli_checks.sh"
 
 # planes NAME MIN MAX ARGS...: exit 0 and between MIN and MAX planes printed.
 planes() {
