@@ -219,7 +219,7 @@ def unfold_batchnorm(model: depth_model.DepthNet, batches) -> depth_model.DepthN
 
 
 def load_checkpoint(path: str):
-    ckpt = torch.load(path, map_location="cpu")
+    ckpt = torch.load(path, map_location="cpu", weights_only=False)
     model = depth_model.build(ckpt["model_name"])
     model.load_state_dict(ckpt["model"])
     return model, ckpt

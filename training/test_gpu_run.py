@@ -46,12 +46,14 @@ class RoundTrip(unittest.TestCase):
             tmp = Path(folder)
             make_photos(tmp)
             env = dict(os.environ, AMPI_PHOTO_ROOT=str(tmp / "photos"))
-            carry, run, out = tmp / "carry", tmp / "run", tmp / "out"
+            carry, out = tmp / "carry", tmp / "out"
+            runs = {"lite": tmp / "lite", "heavy": tmp / "heavy"}
+            run_args = [arg for model, run in runs.items() for arg in ("--run", f"{model}:{run}")]
             for round_trip in range(2):
-                printed = self.run_tool("pack", "--run", str(run), "--carry", str(carry), "--ordinal",
+                printed = self.run_tool("pack", *run_args, "--carry", str(carry), "--ordinal",
                                         str(tmp / "ordinal.json"), "--device", "cpu", "--python", PYTHON, "--size", "64x64",
                                         "--batch", "2", "--ordinal-batch", "2", "--minutes", "0.05",
-                                        "--threads", "1", "--workers", "1", "--val-count", "2", env=env)
+                                        "--threads", "1", "--workers", "2", "--scene-reuse", "2", "--val-count", "2", env=env)
                 packed = json.loads((carry / "ordinal.json").read_text())["photos"][0]
                 self.assertEqual((packed["width"], packed["height"]), (384, 128))   # scaled to 384 px
                 with Image.open(carry / "photos" / "set" / "p0.jpg") as photo:
@@ -63,23 +65,26 @@ class RoundTrip(unittest.TestCase):
                 done = subprocess.run(["bash", "-c", command], cwd=ROOT, env=dict(env, OUT=str(out)),
                                       capture_output=True, text=True)
                 self.assertEqual(done.returncode, 0, done.stdout + done.stderr)
-                self.run_tool("unpack", str(out), "--run", str(run))
-                for name in ("checkpoint.pt", "best.pt", "train.log"):
-                    self.assertTrue((run / name).exists(), name)
-                back = torch.load(out / "checkpoint.pt")
-                self.assertNotIn("optimiser", back)   # slim: under the 16 MiB a returned file may have
-                self.assertIn("lr", back)
-            log = (run / "train.log").read_text()
-            self.assertIn("initialised lite from weights/depth_lite.ampw", log)
-            self.assertIn("(slim: Adam restarts)", log)
-            self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
-            self.assertIn("ordinal_whdr", log)
+                self.run_tool("unpack", str(out), *run_args)
+                for model, run in runs.items():
+                    for name in ("checkpoint.pt", "best.pt", "train.log"):
+                        self.assertTrue((run / name).exists(), f"{model} {name}")
+                    back = torch.load(out / model / "checkpoint.pt")
+                    self.assertNotIn("optimiser", back)   # slim: under the 16 MiB a returned file may have
+                    self.assertIn("lr", back)
+                    self.assertEqual(next(iter(back["model"].values())).dtype, torch.float16)
+            for model, run in runs.items():
+                log = (run / "train.log").read_text()
+                self.assertIn(f"initialised {model} from weights/depth_{model}.ampw", log)
+                self.assertIn("(slim: Adam restarts)", log)
+                self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
+                self.assertIn("ordinal_whdr", log)
 
     def test_unpack_without_files_leaves_the_run_alone(self):
         with tempfile.TemporaryDirectory() as folder:
             empty, run = Path(folder) / "empty", Path(folder) / "run"
             empty.mkdir()
-            result = subprocess.run([PYTHON, str(HERE / "gpu_run.py"), "unpack", str(empty), "--run", str(run)],
+            result = subprocess.run([PYTHON, str(HERE / "gpu_run.py"), "unpack", str(empty), "--run", f"lite:{run}"],
                                     capture_output=True, text=True)
             self.assertNotEqual(result.returncode, 0)
             self.assertIn("did not come back", result.stderr)

@@ -186,29 +186,74 @@ def make_batch(source, first_index: int, batch: int, validation: bool, rng: rand
 
 
 class TrainingBatches(torch.utils.data.Dataset):
-    """Training batch k (from the resumed step on): the synthetic batch of step k, drawn
-    exactly as make_batch draws it, and the step's real photos with their pairs. Indexed by
-    step, so DataLoader workers make them ahead and in parallel, and a resumed run draws
-    the same batches."""
+    """Training group g (from the resumed step's group on): the synthetic batch of group g,
+    drawn exactly as make_batch draws it, and for each of its steps (--scene-reuse
+    consecutive steps share the batch) that step's real photos with their pairs. Indexed by
+    group, so DataLoader workers make groups ahead and in parallel, and a resumed run draws
+    the same batches. Reuse is for machines whose network outruns the scene renderer (a
+    GPU): each rendered scene then teaches several steps, augmented after the first
+    (scene_view)."""
 
     def __init__(self, source, args, size, first_step: int, ordinal_photos):
         self.source, self.args, self.size, self.first_step = source, args, size, first_step
         self.ordinal_photos = ordinal_photos
+        self.first_group = first_step // args.scene_reuse
 
     def __len__(self):
-        return max(0, self.args.steps - self.first_step)
+        return max(0, -(-self.args.steps // self.args.scene_reuse) - self.first_group)
 
     def __getitem__(self, k):
-        step = self.first_step + k
-        rng = random.Random(self.args.seed * 1_000_003 + step)
-        rgb, disp = make_batch(self.source, step * self.args.batch, self.args.batch, False, rng)
-        real, pairs = None, []
-        if self.ordinal_photos:
-            samples = [ordinal_data.training_sample(rng.choice(self.ordinal_photos), self.size, rng)
-                       for _ in range(self.args.ordinal_batch)]
-            real = torch.stack([s[0] for s in samples]).contiguous(memory_format=torch.channels_last)
-            pairs = [(s[1], s[2]) for s in samples]
-        return rgb, disp, real, pairs
+        group, reuse = self.first_group + k, self.args.scene_reuse
+        rng = random.Random(self.args.seed * 1_000_003 + group * reuse)
+        rgb, disp = make_batch(self.source, group * self.args.batch, self.args.batch, False, rng)
+        steps = range(max(group * reuse, self.first_step), min((group + 1) * reuse, self.args.steps))
+        real = [self.real_photos(random.Random(f"real photos {self.args.seed} {step}")) for step in steps]
+        return rgb, disp, list(steps), real
+
+    def real_photos(self, rng: random.Random):
+        if not self.ordinal_photos:
+            return None, []
+        samples = [ordinal_data.training_sample(rng.choice(self.ordinal_photos), self.size, rng)
+                   for _ in range(self.args.ordinal_batch)]
+        real = torch.stack([s[0] for s in samples]).contiguous(memory_format=torch.channels_last)
+        return real, [(s[1], s[2]) for s in samples]
+
+
+def scene_view(rgb, disp, step: int, args):
+    """The synthetic batch as step trains it: as drawn at the first step of its group, a
+    new augmented view (augment_scene_batch) at each later one."""
+    if step % args.scene_reuse == 0:
+        return rgb, disp
+    return augment_scene_batch(rgb, disp, random.Random(f"augment {args.seed} {step}"))
+
+
+ZOOM = (1.0, 1.5)        # crop side = image side / zoom
+COLOUR_GAIN = (0.85, 1.15)
+GAMMA = (0.8, 1.25)
+
+
+def augment_scene_batch(rgb: torch.Tensor, disp: torch.Tensor, rng: random.Random):
+    """Another view of the same scenes for a reused batch: per image a random crop (1/1.5
+    to all of each side) resized back, a horizontal flip half the time, a gain per colour
+    channel and a gamma. Disparity is cropped, resized and flipped along; it needs no other
+    change, since the loss normalises each target's range."""
+    h, w = rgb.shape[-2:]
+    rgbs, disps = [], []
+    for image, target in zip(rgb, disp):
+        zoom = rng.uniform(*ZOOM)
+        ch, cw = round(h / zoom), round(w / zoom)
+        y0, x0 = rng.randint(0, h - ch), rng.randint(0, w - cw)
+        image = F.interpolate(image[None, :, y0:y0 + ch, x0:x0 + cw], size=(h, w), mode="bilinear",
+                              align_corners=False)[0]
+        target = F.interpolate(target[None, :, y0:y0 + ch, x0:x0 + cw], size=(h, w), mode="bilinear",
+                               align_corners=False)[0]
+        if rng.random() < 0.5:
+            image, target = image.flip(-1), target.flip(-1)
+        gain = torch.tensor([rng.uniform(*COLOUR_GAIN) for _ in range(3)], device=rgb.device).view(3, 1, 1)
+        image = (image.clamp(0, 1) ** rng.uniform(*GAMMA) * gain).clamp(0, 1)
+        rgbs.append(image)
+        disps.append(target)
+    return torch.stack(rgbs).contiguous(memory_format=torch.channels_last), torch.stack(disps)
 
 
 def _worker_init(_):
@@ -238,20 +283,18 @@ def aligned_metrics(pred: torch.Tensor, target: torch.Tensor) -> dict:
 
 
 @torch.no_grad()
-def validate(model, source, count: int, batch: int, device="cpu"):
-    """(mean loss, mean metrics) over the fixed validation set."""
+def validate(model, batches, device="cpu"):
+    """(mean loss, mean metrics) over the fixed validation batches."""
     model.eval()
-    total, metrics, batches = 0.0, [], 0
-    for first in range(0, count, batch):
-        rgb, disp = make_batch(source, first, min(batch, count - first), True, random.Random(0))
+    total, metrics = 0.0, []
+    for rgb, disp in batches:
         rgb, disp = rgb.to(device), disp.to(device)
         outputs = model(rgb)
         loss, _ = losses.depth_loss(outputs, disp)
         total += float(loss)
         metrics.append(list(aligned_metrics(outputs[-1], disp).values()))
-        batches += 1
     model.train()
-    return total / batches, dict(zip(METRIC_NAMES, np.mean(metrics, axis=0).tolist()))
+    return total / len(batches), dict(zip(METRIC_NAMES, np.mean(metrics, axis=0).tolist()))
 
 
 @torch.no_grad()
@@ -295,14 +338,14 @@ def initial_model(args, source, size, resuming: bool):
         return depth_model.build(args.model)
     if not args.init.endswith(".ampw"):
         model = depth_model.build(args.model)
-        model.load_state_dict(torch.load(args.init, map_location="cpu")["model"])
+        model.load_state_dict(torch.load(args.init, map_location="cpu", weights_only=False)["model"])
         return model
     import export_depth
     model = export_depth.import_ampw(args.init)
     if model.arch["name"] != args.model:
         raise SystemExit(f"--init {args.init}: holds a {model.arch['name']} network, not {args.model}")
     rng = random.Random(args.seed)
-    batches = [make_batch(source, VAL_SEED_START // 2 + i * args.batch, args.batch, False, rng)[0] for i in range(8)]
+    batches = [make_batch(source, VAL_SEED_START // 2 + i * 8, 8, False, rng)[0] for i in range(8)]
     return export_depth.unfold_batchnorm(model, batches).train()
 
 
@@ -330,7 +373,7 @@ def resume(ckpt_path: Path, model, optimiser, scheduler, args, best_of: str):
     """(step, best score) of the checkpoint, its state loaded into model, optimiser and
     scheduler. A slim checkpoint (training/gpu_run.py) has no Adam moments: they start
     again at its learning rate. A best score of another measure than best_of is dropped."""
-    ckpt = torch.load(ckpt_path, map_location=args.device)
+    ckpt = torch.load(ckpt_path, map_location=args.device, weights_only=False)
     if ckpt["model_name"] != args.model:
         raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
     model.load_state_dict(ckpt["model"])
@@ -385,9 +428,12 @@ def train(args):
             "model_name": args.model, "model": model.state_dict(), "optimiser": optimiser.state_dict(),
             "scheduler": scheduler.state_dict(), "step": step, "best_val": best, "best_of": best_of})
 
+    val_batches = [make_batch(source, first, min(args.batch, val_count - first), True, random.Random(0))
+                   for first in range(0, val_count, args.batch)]  # rendered once, not every validation
+
     def validation():
         nonlocal best
-        val_loss, metrics = validate(model, source, val_count, args.batch, args.device)
+        val_loss, metrics = validate(model, val_batches, args.device)
         scheduler.step(val_loss)
         whdr = validate_ordinal(model, ordinal_val, size, args.device) if ordinal_val else None
         score = whdr if whdr is not None else val_loss
@@ -401,26 +447,32 @@ def train(args):
             shown += f" ordinal_whdr {whdr:.4f}"
         log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
 
-    ahead = {"num_workers": args.workers, "worker_init_fn": _worker_init, "prefetch_factor": 4} if args.workers else {}
+    ahead = {"num_workers": args.workers, "worker_init_fn": _worker_init, "prefetch_factor": 2} if args.workers else {}
     batches = torch.utils.data.DataLoader(TrainingBatches(source, args, size, step, ordinal_train),
                                           batch_size=None, shuffle=False, **ahead)
     t0, seen, timed_from = time.time(), 0, None
-    for batch in batches:
-        loss, parts, rank = training_step(model, optimiser, batch, args)
-        step += 1
-        seen += 1
-        trained_until = time.time()
-        if seen == 1:
-            timed_from = trained_until  # the rate leaves out start-up and the first step
-        if step % args.log_every == 0:
-            log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
-                          f"rank {float(rank):.4f} lr {optimiser.param_groups[0]['lr']:.2e} "
-                          f"{(time.time() - t0) / seen:.2f} s/step")
-        out_of_time = args.minutes > 0 and time.time() - t0 >= 60 * args.minutes
-        if step % args.val_every == 0 or step == args.steps or out_of_time:
-            validation()
-        if step % args.checkpoint_every == 0 or step == args.steps or out_of_time:
-            checkpoint()
+    for rgb, disp, steps, real in batches:
+        rgb = rgb.to(args.device, non_blocking=True)
+        disp = disp.to(args.device, non_blocking=True)
+        for step_of_batch, (real_rgb, pairs) in zip(steps, real):
+            loss, parts, rank = training_step(model, optimiser,
+                                              (*scene_view(rgb, disp, step_of_batch, args), real_rgb, pairs), args)
+            step += 1
+            seen += 1
+            trained_until = time.time()
+            if seen == 1:
+                timed_from = trained_until  # the rate leaves out start-up and the first step
+            if step % args.log_every == 0:
+                log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
+                              f"rank {float(rank):.4f} lr {optimiser.param_groups[0]['lr']:.2e} "
+                              f"{(time.time() - t0) / seen:.2f} s/step")
+            out_of_time = args.minutes > 0 and time.time() - t0 >= 60 * args.minutes
+            if step % args.val_every == 0 or step == args.steps or out_of_time:
+                validation()
+            if step % args.checkpoint_every == 0 or step == args.steps or out_of_time:
+                checkpoint()
+            if out_of_time:
+                break
         if out_of_time:
             log_line(run, f"stopped after {args.minutes:g} minutes at step {step}")
             break
@@ -451,6 +503,8 @@ def main(argv=None):
     p.add_argument("--device", default="cpu", help="cpu, or cuda on a GPU machine")
     p.add_argument("--minutes", type=float, default=0,
                    help="stop after this many minutes, validated and checkpointed (0: run to --steps)")
+    p.add_argument("--scene-reuse", type=int, default=1,
+                   help="steps each rendered scene batch trains, augmented after the first (a GPU's setting)")
     p.add_argument("--workers", type=int, default=1, help="processes making batches ahead (0: in the loop)")
     p.add_argument("--ordinal", help="ordinal set (training/ordinal/ordinal.json): ranking loss on its "
                                      "training photos, WHDR on its validation photos")
