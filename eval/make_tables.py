@@ -379,7 +379,7 @@ def edges_table(ampi, threads):
         '',
         'Made by `/usr/bin/python3 eval/make_tables.py edges --ampi AMPI`. Scenes of textured',
         'fronto-parallel surfaces whose new views are known exactly (`eval/edge_eval.h`): a disk',
-        'over a background (the README's scene), a thin pole, a person-like silhouette, two objects',
+        'over a background (the README\'s scene), a thin pole, a person-like silhouette, two objects',
         'at different depths; 640x480, disparity 1 (and 0.6) over 0.25. Each scene\'s disparity map',
         'is made soft (reduced 4 or 8 times and enlarged bilinearly, as a network\'s map is; or',
         'hard) and made into an MPI as `ampi run --depth` does (8 planes at most, the inpainting',
