@@ -206,11 +206,11 @@ TEST_CASE("layer_norm over strided tokens matches the double reference on every 
 
 TEST_CASE("self_attention streamed over key blocks equals softmax attention, on every ISA") {
   struct Case { int tokens, dim, heads; };
-  // Token counts below, at and across the 64-query and 256-key blocks; head widths
-  // around the vector widths.
+  // Token counts below, at and across the 96-query and 1,536-key blocks (three blocks of
+  // keys at 3,100); head widths around the vector widths.
   const std::vector<Case> cases = test::sweep<Case>(
-      {{1, 8, 1}, {5, 12, 3}, {64, 16, 2}, {65, 34, 2}, {257, 16, 1}, {300, 51, 3}},
-      {{5, 12, 3}, {65, 34, 2}, {257, 8, 1}});
+      {{1, 8, 1}, {5, 12, 3}, {96, 16, 2}, {97, 34, 2}, {300, 51, 3}, {1537, 16, 1}, {3100, 8, 1}},
+      {{5, 12, 3}, {97, 34, 2}, {1537, 8, 1}});
   for (Isa isa : runnable_isas())
     for (ThreadPool* pool : test::thread_pools())
       for (const Case& k : cases) {
