@@ -3,7 +3,7 @@
 // chains cover the FMA latency (4 cycles) on two FMA ports. A panel whose last columns
 // fit in one vector runs a 6x8 tile instead of multiplying zeros.
 // Outputs larger than the last-level cache keep plain stores (GemmArgs::stream_c is
-// ignored): streaming them as the AVX-512 tile does measured slower on AMD Zen 4 with
+// ignored): streaming them as the AVX-512 tile does measured slower on this AMD EPYC (Zen 5) with
 // 256-bit stores, 1x1 16->64 at 512x384 4.95 -> 5.17 ms (cpu clock, 1 thread, medians
 // of alternating runs). Splitting the 6x8 tile's k over two accumulator sets (12 chains
 // instead of 6) measured no better on 1x1 96->24 (2.53 -> 2.52 ms).
