@@ -14,10 +14,11 @@ ordinal set with its points scaled to those sizes. The runs train side by side o
 GPU, the machine's cores shared out among their DataLoader workers that make the scenes;
 the GPU outruns the scene renderer, so each scene batch trains --scene-reuse steps
 (augmented after the first). --minutes stops each run validated and checkpointed inside
-the command's limit. Checkpoints cross slim: no Adam moments and the weights in half
+the command's limit; validation measures an exponential moving average of the weights
+(--ema). Checkpoints cross slim: no Adam moments, the average as the weights, in half
 precision (a returned file may have 16 MiB, all of them 64 MiB; heavy's weights alone are
-25 MB in fp32): the run resumes with its weights, step, schedule and learning rate, and
-Adam's moments start again. `unpack` puts checkpoint.pt (and best.pt, when the GPU run
+25 MB in fp32): the run resumes with those weights, its step, schedule and learning rate,
+and Adam's moments start again. `unpack` puts checkpoint.pt (and best.pt, when the GPU run
 beat the best so far) into each run folder and appends the run's log to its train.log, so
 the next `pack` resumes where the GPU stopped, here or there.
 """
@@ -42,11 +43,16 @@ ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
 
 def slim_checkpoint(source: Path, target: Path):
     """The checkpoint without Adam's moments, with the learning rate, and its floating-point
-    weights in half precision where they fit: what crosses to the GPU machine and back."""
+    weights (the average's, when the run keeps one) in half precision where they fit: what
+    crosses to the GPU machine and back."""
     import torch
     ckpt = torch.load(source, map_location="cpu", weights_only=False)  # our own file, from any torch
     slim = {k: v for k, v in ckpt.items() if k != "optimiser"}
-    slim["model"] = {name: half_if_exact_enough(t) for name, t in ckpt["model"].items()}
+    # With a weight average (train_depth.py --ema) the average crosses as the weights: two
+    # sets would not fit (heavy's alone is 12.6 MB in fp16), and a run resumed from its
+    # average, the average restarting there, loses nothing worth the bytes.
+    weights = slim.pop("ema", ckpt["model"])
+    slim["model"] = {name: half_if_exact_enough(t) for name, t in weights.items()}
     if "optimiser" in ckpt:
         slim["lr"] = ckpt["optimiser"]["param_groups"][0]["lr"]
     torch.save(slim, target)
@@ -116,6 +122,7 @@ def train_script(args, models) -> str:
             f"{args.python} training/train_depth.py --model {model} --run {c}/{model} --data scenes "
             f"--size {args.size} --batch {args.batch} --init weights/depth_{model}.ampw --steps 10000000 "
             f"--device {args.device} --threads {args.threads} --workers {workers} --scene-reuse {args.scene_reuse} "
+            f"--ema {args.ema} "
             f"--minutes {args.minutes} --val-every {args.val_every} --val-count {args.val_count} "
             f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
             f"> {c}/{model}/console.txt 2>&1 & pids+=($!)")
@@ -194,6 +201,8 @@ def main():
     pack.add_argument("--workers", type=int, default=15,
                       help="scene-making processes, shared out among the runs (the machine has 16 cores)")
     pack.add_argument("--scene-reuse", type=int, default=4, help="steps each rendered scene batch trains")
+    pack.add_argument("--ema", type=float, default=0.999,
+                      help="decay of the weight average that validation measures (0: none)")
     pack.add_argument("--val-count", type=int, default=32)
     pack.add_argument("--size", default="256x192")
     pack.add_argument("--batch", type=int, default=48)

@@ -73,10 +73,12 @@ class RoundTrip(unittest.TestCase):
                     self.assertNotIn("optimiser", back)   # slim: under the 16 MiB a returned file may have
                     self.assertIn("lr", back)
                     self.assertEqual(next(iter(back["model"].values())).dtype, torch.float16)
+                    self.assertNotIn("ema", back)   # --ema 0.999: the average crosses as the weights
             for model, run in runs.items():
                 log = (run / "train.log").read_text()
                 self.assertIn(f"initialised {model} from weights/depth_{model}.ampw", log)
                 self.assertIn("(slim: Adam restarts)", log)
+                self.assertIn("weights averaged (decay 0.999)", log)
                 self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
                 self.assertIn("ordinal_whdr", log)
 

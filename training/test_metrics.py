@@ -37,5 +37,24 @@ class AlignedMetricsTest(unittest.TestCase):
         self.assertLess(m["delta1.25"], 1.0)
 
 
+class WeightAverageTest(unittest.TestCase):
+    def test_moves_each_float_by_one_minus_decay_and_copies_counters(self):
+        model = torch.nn.Sequential(torch.nn.Linear(3, 2), torch.nn.BatchNorm1d(2))
+        average = train_depth.WeightAverage(model, decay=0.75)
+        before = {k: v.clone() for k, v in average.model.state_dict().items()}
+        with torch.no_grad():
+            for p in model.parameters():
+                p.add_(4.0)
+            model[1].running_mean.add_(8.0)
+            model[1].num_batches_tracked.fill_(5)
+        average.update(model)
+        after = average.model.state_dict()
+        for name, p in model.named_parameters():
+            torch.testing.assert_close(after[name], before[name] + 1.0)   # a quarter of the way
+        torch.testing.assert_close(after["1.running_mean"], before["1.running_mean"] + 2.0)
+        self.assertEqual(int(after["1.num_batches_tracked"]), 5)
+        self.assertFalse(any(p.requires_grad for p in average.model.parameters()))
+
+
 if __name__ == "__main__":
     unittest.main()

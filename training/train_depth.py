@@ -369,14 +369,39 @@ def training_step(model, optimiser, batch, args):
     return loss, parts, rank
 
 
-def resume(ckpt_path: Path, model, optimiser, scheduler, args, best_of: str):
-    """(step, best score) of the checkpoint, its state loaded into model, optimiser and
-    scheduler. A slim checkpoint (training/gpu_run.py) has no Adam moments: they start
-    again at its learning rate. A best score of another measure than best_of is dropped."""
+class WeightAverage:
+    """An exponential moving average of the weights and BatchNorm statistics (--ema):
+    what validation measures and best.pt keeps when on. At a learning rate where the
+    ordinal validation swings by several points from one validation to the next, the
+    average of the recent steps is steadier than any one of them."""
+
+    def __init__(self, model, decay: float):
+        import copy
+        self.decay = decay
+        self.model = copy.deepcopy(model).eval()
+        for p in self.model.parameters():
+            p.requires_grad_(False)
+
+    @torch.no_grad()
+    def update(self, model):
+        for mine, theirs in zip(self.model.state_dict().values(), model.state_dict().values()):
+            if mine.dtype.is_floating_point:
+                mine.mul_(self.decay).add_(theirs, alpha=1.0 - self.decay)
+            else:
+                mine.copy_(theirs)
+
+
+def resume(ckpt_path: Path, model, average, optimiser, scheduler, args, best_of: str):
+    """(step, best score) of the checkpoint, its state loaded into model, the weight
+    average (or None), optimiser and scheduler. A slim checkpoint (training/gpu_run.py)
+    has no Adam moments: they start again at its learning rate. A best score of another
+    measure than best_of is dropped."""
     ckpt = torch.load(ckpt_path, map_location=args.device, weights_only=False)
     if ckpt["model_name"] != args.model:
         raise SystemExit(f"{ckpt_path}: holds a {ckpt['model_name']} model, not {args.model}")
     model.load_state_dict(ckpt["model"])
+    if average is not None:  # a checkpoint without one starts the average at its weights
+        average.model.load_state_dict(ckpt.get("ema", ckpt["model"]))
     scheduler.load_state_dict(ckpt["scheduler"])
     if "optimiser" in ckpt:
         optimiser.load_state_dict(ckpt["optimiser"])
@@ -412,34 +437,39 @@ def train(args):
     scheduler = torch.optim.lr_scheduler.ReduceLROnPlateau(
         optimiser, factor=0.2, patience=args.patience)
     step, best = 0, math.inf
+    average = WeightAverage(model, args.ema) if args.ema else None
+    measured = average.model if average else model  # what validation measures and best.pt keeps
     if ckpt_path.exists():
-        step, best, note = resume(ckpt_path, model, optimiser, scheduler, args, best_of)
+        step, best, note = resume(ckpt_path, model, average, optimiser, scheduler, args, best_of)
         log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}{note}")
     elif args.init:
         log_line(run, f"initialised {args.model} from {args.init}")
     val_count = source.validation_count(args.val_count)
     real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g})"
             if ordinal_train else "")
+    ema = f", weights averaged (decay {args.ema:g})" if average else ""
     log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data}{real} "
-                  f"at {size[0]}x{size[1]}, batch {args.batch}, {args.threads} threads, {args.workers} workers")
+                  f"at {size[0]}x{size[1]}, batch {args.batch}, lr {optimiser.param_groups[0]['lr']:.2e}{ema}, "
+                  f"{args.threads} threads, {args.workers} workers")
 
     def checkpoint():
         save_checkpoint(ckpt_path, {
             "model_name": args.model, "model": model.state_dict(), "optimiser": optimiser.state_dict(),
-            "scheduler": scheduler.state_dict(), "step": step, "best_val": best, "best_of": best_of})
+            "scheduler": scheduler.state_dict(), "step": step, "best_val": best, "best_of": best_of,
+            **({"ema": average.model.state_dict()} if average else {})})
 
     val_batches = [make_batch(source, first, min(args.batch, val_count - first), True, random.Random(0))
                    for first in range(0, val_count, args.batch)]  # rendered once, not every validation
 
     def validation():
         nonlocal best
-        val_loss, metrics = validate(model, val_batches, args.device)
+        val_loss, metrics = validate(measured, val_batches, args.device)
         scheduler.step(val_loss)
-        whdr = validate_ordinal(model, ordinal_val, size, args.device) if ordinal_val else None
+        whdr = validate_ordinal(measured, ordinal_val, size, args.device) if ordinal_val else None
         score = whdr if whdr is not None else val_loss
         if score < best:  # the weights worth exporting, kept apart from the latest
             best = score
-            save_checkpoint(run / "best.pt", {"model_name": args.model, "model": model.state_dict(),
+            save_checkpoint(run / "best.pt", {"model_name": args.model, "model": measured.state_dict(),
                                               "step": step, "val_loss": val_loss, "metrics": metrics,
                                               "ordinal_whdr": whdr})
         shown = " ".join(f"{name} {value:.4f}" for name, value in metrics.items())
@@ -457,6 +487,8 @@ def train(args):
         for step_of_batch, (real_rgb, pairs) in zip(steps, real):
             loss, parts, rank = training_step(model, optimiser,
                                               (*scene_view(rgb, disp, step_of_batch, args), real_rgb, pairs), args)
+            if average:
+                average.update(model)
             step += 1
             seen += 1
             trained_until = time.time()
@@ -510,6 +542,9 @@ def main(argv=None):
                                      "training photos, WHDR on its validation photos")
     p.add_argument("--ordinal-batch", type=int, default=4, help="real photos per step with --ordinal")
     p.add_argument("--rank-weight", type=float, default=1.0, help="weight of the ranking loss")
+    p.add_argument("--ema", type=float, default=0.0,
+                   help="validate and keep an exponential moving average of the weights with this decay "
+                        "(e.g. 0.999; 0: the weights as trained)")
     return train(p.parse_args(argv))
 
 
