@@ -298,15 +298,19 @@ def validate(model, batches, device="cpu"):
 
 
 @torch.no_grad()
-def validate_ordinal(model, photos, size, device="cpu"):
-    """WHDR of the network on the ordinal validation photos, each resized to size."""
+def validate_ordinal(model, photos, long_side: int, device="cpu"):
+    """WHDR of the network on the ordinal validation photos, each run as the engine runs
+    it: long side long_side, aspect kept, edge-replicated to the network's multiple and
+    the output cropped back (nets/depth_net.cpp)."""
     model.eval()
     wrong, pairs = 0.0, 0
     for photo in photos:
-        rgb, points, signs = ordinal_data.validation_sample(photo, size)
-        rgb = rgb[None].to(device).contiguous(memory_format=torch.channels_last)
-        w, n = ordinal_data.whdr_counts(model(rgb)[-1][0].cpu(), points, signs)
-        wrong, pairs = wrong + w, pairs + n
+        rgb, points, signs = ordinal_data.validation_sample(photo, long_side)
+        height, width = rgb.shape[-2:]
+        padded = F.pad(rgb[None], (0, (-width) % model.multiple, 0, (-height) % model.multiple), mode="replicate")
+        disparity = model(padded.to(device).contiguous(memory_format=torch.channels_last))[-1][0, :, :height, :width]
+        photo_wrong, photo_pairs = ordinal_data.whdr_counts(disparity.cpu(), points, signs)
+        wrong, pairs = wrong + photo_wrong, pairs + photo_pairs
     model.train()
     return wrong / max(pairs, 1)
 
@@ -465,7 +469,7 @@ def train(args):
         nonlocal best
         val_loss, metrics = validate(measured, val_batches, args.device)
         scheduler.step(val_loss)
-        whdr = validate_ordinal(measured, ordinal_val, size, args.device) if ordinal_val else None
+        whdr = validate_ordinal(measured, ordinal_val, max(size), args.device) if ordinal_val else None
         score = whdr if whdr is not None else val_loss
         if score < best:  # the weights worth exporting, kept apart from the latest
             best = score
