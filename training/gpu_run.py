@@ -2,10 +2,10 @@
 other: pack what the runs need here, train there, bring the checkpoints back.
 
     # here: the photos (downscaled), the ordinal set, each run's checkpoint and the script
-    /usr/bin/python3 training/gpu_run.py pack --run lite:training/runs/lite-256 --run heavy:training/runs/heavy-256
+    /usr/bin/python3 training/gpu_run.py pack --run lite:training/runs/lite-gpu --run heavy:training/runs/heavy-gpu
     # there (the device tool's `run`, carry ["carry"]): bash carry/train.sh
     # here again: the files that came back into the run folders
-    /usr/bin/python3 training/gpu_run.py unpack FILES_AT --run lite:training/runs/lite-256 --run heavy:training/runs/heavy-256
+    /usr/bin/python3 training/gpu_run.py unpack FILES_AT --run lite:training/runs/lite-gpu --run heavy:training/runs/heavy-gpu
 
 The GPU machine gets only the working tree and the carried folder (64 MiB in all), not
 ../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the
@@ -102,7 +102,7 @@ def parse_runs(specs):
     for spec in specs:
         model, sep, folder = spec.partition(":")
         if not sep or not folder:
-            raise SystemExit(f"--run {spec}: expected MODEL:DIR, e.g. lite:training/runs/lite-256")
+            raise SystemExit(f"--run {spec}: expected MODEL:DIR, e.g. lite:training/runs/lite-gpu")
         runs.append((model, Path(folder)))
     if len({model for model, _ in runs}) != len(runs):
         raise SystemExit("--run: one run per model")
