@@ -3,6 +3,7 @@
 // so it takes the vector path too (the vector exp included).
 #include <cmath>
 
+#include "kernels/arm/neon_channels.h"
 #include "kernels/arm/neon_kernels.h"
 #include "kernels/arm/neon_math.h"
 
@@ -111,27 +112,13 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   return factor;
 }
 
+namespace {
+#include "kernels/bilinear_lanes.inl"
+}  // namespace
+
 void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
                   const float* wx, int out_w, int c, float* out) {
-  const float32x4_t vy = vdupq_n_f32(wy);
-  for (int x = 0; x < out_w; ++x) {
-    const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;
-    const float *b0 = bottom + int64_t{x0[x]} * c, *b1 = bottom + int64_t{x1[x]} * c;
-    float* o = out + int64_t{x} * c;
-    const float32x4_t vx = vdupq_n_f32(wx[x]);
-    int ch = 0;
-    for (; ch + 4 <= c; ch += 4) {
-      const float32x4_t t0v = vld1q_f32(t0 + ch), b0v = vld1q_f32(b0 + ch);
-      const float32x4_t t = vfmaq_f32(t0v, vx, vsubq_f32(vld1q_f32(t1 + ch), t0v));
-      const float32x4_t b = vfmaq_f32(b0v, vx, vsubq_f32(vld1q_f32(b1 + ch), b0v));
-      vst1q_f32(o + ch, vfmaq_f32(t, vy, vsubq_f32(b, t)));
-    }
-    for (; ch < c; ++ch) {
-      const float t = t0[ch] + wx[x] * (t1[ch] - t0[ch]);
-      const float b = b0[ch] + wx[x] * (b1[ch] - b0[ch]);
-      o[ch] = t + wy * (b - t);
-    }
-  }
+  bilinear_row_channels(top, bottom, wy, x0, x1, wx, out_w, c, out);
 }
 
 }  // namespace ampi::neon

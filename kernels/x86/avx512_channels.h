@@ -31,6 +31,7 @@ inline void finish_streaming() { _mm_sfence(); }
 
 // The arithmetic lane-generic kernel bodies (kernels/*_lanes.inl) are written with.
 inline __m512 plus(__m512 a, __m512 b) { return _mm512_add_ps(a, b); }
+inline __m512 minus(__m512 a, __m512 b) { return _mm512_sub_ps(a, b); }
 inline __m512 fmadd(__m512 a, __m512 b, __m512 c) { return _mm512_fmadd_ps(a, b, c); }
 // Keeps a loaded vector in a register: GCC otherwise folds the load into each FMA that
 // uses it, and a 3x3 depthwise block then issues 27 loads per kernel row for 24 FMAs,

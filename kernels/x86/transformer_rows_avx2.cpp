@@ -1,8 +1,9 @@
-// AVX2 transformer row kernels (contracts in kernels/kernel_list.def). Tails go through
-// masked loads and stores, so every element takes the vector path and no scalar helper
-// from a shared header is compiled with AVX2 flags (cmake/isa.cmake); whole vectors use
-// plain ones, as vmaskmovps stores are slow on AMD's cores (measured: softmax 3x slower
-// with every store masked).
+// AVX2 transformer row kernels (contracts in kernels/kernel_list.def). The row kernels'
+// tails go through masked loads and stores, so every element takes the vector path and
+// no scalar helper from a shared header is compiled with AVX2 flags (cmake/isa.cmake);
+// whole vectors use plain ones, as vmaskmovps stores are slow on AMD's cores (measured:
+// softmax 3x slower with every store masked). bilinear_row over several channels is the
+// lane-generic kernels/bilinear_lanes.inl, leftover channels scalar as in avx2_channels.h.
 #include <cmath>
 
 #include "kernels/x86/avx2_channels.h"
@@ -137,30 +138,14 @@ void bilinear_row_one_channel(const float* top, const float* bottom, float wy, c
 
 }  // namespace
 
+namespace {
+#include "kernels/bilinear_lanes.inl"
+}  // namespace
+
 void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
                   const float* wx, int out_w, int c, float* out) {
   if (c == 1) return bilinear_row_one_channel(top, bottom, wy, x0, x1, wx, out_w, out);
-  const __m256 vy = _mm256_set1_ps(wy);
-  for (int x = 0; x < out_w; ++x) {
-    const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;
-    const float *b0 = bottom + int64_t{x0[x]} * c, *b1 = bottom + int64_t{x1[x]} * c;
-    float* o = out + int64_t{x} * c;
-    const __m256 vx = _mm256_set1_ps(wx[x]);
-    int ch = 0;
-    for (; ch + 8 <= c; ch += 8) {
-      const __m256 t0v = _mm256_loadu_ps(t0 + ch), b0v = _mm256_loadu_ps(b0 + ch);
-      const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_loadu_ps(t1 + ch), t0v), t0v);
-      const __m256 b = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_loadu_ps(b1 + ch), b0v), b0v);
-      _mm256_storeu_ps(o + ch, _mm256_fmadd_ps(vy, _mm256_sub_ps(b, t), t));
-    }
-    if (ch < c) {
-      const __m256i mask = tail_mask(c - ch);
-      const __m256 t0v = _mm256_maskload_ps(t0 + ch, mask), b0v = _mm256_maskload_ps(b0 + ch, mask);
-      const __m256 t = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_maskload_ps(t1 + ch, mask), t0v), t0v);
-      const __m256 b = _mm256_fmadd_ps(vx, _mm256_sub_ps(_mm256_maskload_ps(b1 + ch, mask), b0v), b0v);
-      _mm256_maskstore_ps(o + ch, mask, _mm256_fmadd_ps(vy, _mm256_sub_ps(b, t), t));
-    }
-  }
+  bilinear_row_channels(top, bottom, wy, x0, x1, wx, out_w, c, out);
 }
 
 }  // namespace ampi::avx2

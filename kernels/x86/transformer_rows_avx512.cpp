@@ -8,6 +8,7 @@
 // conv_depthwise_avx512.cpp), so it is off for the file.
 #pragma GCC diagnostic ignored "-Wuninitialized"
 
+#include "kernels/x86/avx512_channels.h"
 #include "kernels/x86/avx512_kernels.h"
 #include "kernels/x86/avx512_math.h"
 
@@ -122,30 +123,14 @@ void bilinear_row_one_channel(const float* top, const float* bottom, float wy, c
 
 }  // namespace
 
+namespace {
+#include "kernels/bilinear_lanes.inl"
+}  // namespace
+
 void bilinear_row(const float* top, const float* bottom, float wy, const int32_t* x0, const int32_t* x1,
                   const float* wx, int out_w, int c, float* out) {
   if (c == 1) return bilinear_row_one_channel(top, bottom, wy, x0, x1, wx, out_w, out);
-  const __m512 vy = _mm512_set1_ps(wy);
-  for (int x = 0; x < out_w; ++x) {
-    const float *t0 = top + int64_t{x0[x]} * c, *t1 = top + int64_t{x1[x]} * c;
-    const float *b0 = bottom + int64_t{x0[x]} * c, *b1 = bottom + int64_t{x1[x]} * c;
-    float* o = out + int64_t{x} * c;
-    const __m512 vx = _mm512_set1_ps(wx[x]);
-    int ch = 0;
-    for (; ch + 16 <= c; ch += 16) {
-      const __m512 t0v = _mm512_loadu_ps(t0 + ch), b0v = _mm512_loadu_ps(b0 + ch);
-      const __m512 t = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_loadu_ps(t1 + ch), t0v), t0v);
-      const __m512 b = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_loadu_ps(b1 + ch), b0v), b0v);
-      _mm512_storeu_ps(o + ch, _mm512_fmadd_ps(vy, _mm512_sub_ps(b, t), t));
-    }
-    if (ch < c) {
-      const __mmask16 mask = tail_mask(c - ch);
-      const __m512 t0v = _mm512_maskz_loadu_ps(mask, t0 + ch), b0v = _mm512_maskz_loadu_ps(mask, b0 + ch);
-      const __m512 t = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_maskz_loadu_ps(mask, t1 + ch), t0v), t0v);
-      const __m512 b = _mm512_fmadd_ps(vx, _mm512_sub_ps(_mm512_maskz_loadu_ps(mask, b1 + ch), b0v), b0v);
-      _mm512_mask_storeu_ps(o + ch, mask, _mm512_fmadd_ps(vy, _mm512_sub_ps(b, t), t));
-    }
-  }
+  bilinear_row_channels(top, bottom, wy, x0, x1, wx, out_w, c, out);
 }
 
 }  // namespace ampi::avx512
