@@ -4,7 +4,7 @@
 // [out_c][kernel_h][kernel_w][in_c / groups] (PyTorch's OIHW transposed), bias [out_c].
 // The epilogue is fused: out = act(conv(in) + bias) + residual.
 //
-// Conv2d packs its weights once, for one dispatch table, and picks one of five paths by
+// Conv2d packs its weights once, for one dispatch table, and picks one of six paths by
 // shape (the choice is fixed at construction):
 //   pointwise  1x1, stride 1, no padding, groups 1: the input already is the GEMM's A
 //              matrix (pixels x in_c); the GEMM op (kernels/gemm.h) runs on it directly
@@ -16,6 +16,15 @@
 //              AVX-512 tile's lanes or less. Instead one gemm over each input row gives
 //              every tap's contribution (kernel_h*kernel_w*out_c columns), and each output
 //              pixel adds its taps' contributions from the rows and columns they read.
+//   winograd   a 3x3 convolution, stride 1, no dilation, one group, at least 8 inputs
+//              and more than 4 outputs: Winograd's F(4x4, 3x3) (kernels/winograd.h), a
+//              quarter of the multiply-adds. Per chunk of 4x4 output tiles (in row-major
+//              order, sized to stay in L2): the table's winograd_input transforms each
+//              tile's 6x6 window, 36 GEMMs [tiles x in_c] x [in_c x out_c] run on the
+//              micro-kernel (the filters transformed and packed once), winograd_output
+//              makes the outputs with the epilogue. It rounds differently from a direct
+//              sum, within the same 1e-5 of the output's scale the tests hold every path
+//              to.
 //   rows       any other convolution with one group (implicit GEMM): for an output row,
 //              the gemm's A rows are read straight from the input rows, a_stride
 //              stride_w*in_c apart; one call per kernel row adds a run of kernel_w*in_c
@@ -24,9 +33,10 @@
 //              once, not once per tap as im2col does.
 //   general    anything else (grouped, or runs under 16 floats): per pixel tile and group,
 //              im2col into a per-thread scratch buffer, then the same gemm tile.
-// Threads split the output pixels (pointwise, general) or output rows (depthwise, taps,
-// rows); every output value is computed by the same code in the same order whatever the
-// thread count, so results are bitwise identical across thread counts.
+// Threads split the output pixels (pointwise, general), output rows (depthwise, taps,
+// rows) or chunks of tile rows (winograd); every output value is computed by the same
+// code in the same order whatever the thread count, so results are bitwise identical
+// across thread counts.
 #pragma once
 #include <cstdint>
 #include <memory>
@@ -58,7 +68,7 @@ void validate(const ConvParams& p);
 
 class Conv2d {
  public:
-  enum class Path { Pointwise, Depthwise, Taps, Rows, General };
+  enum class Path { Pointwise, Depthwise, Taps, Winograd, Rows, General };
 
   Conv2d() = default;
   // weights OHWI [out_c][kernel_h][kernel_w][in_c/groups]; bias [out_c] or nullptr.
@@ -99,6 +109,8 @@ class Conv2d {
                      ThreadPool& pool) const;
   void run_taps(const float* in, int in_h, int in_w, float* out, const float* residual,
                 ThreadPool& pool) const;
+  void run_winograd(const float* in, int in_h, int in_w, float* out, const float* residual,
+                    ThreadPool& pool) const;
   void run_rows(const float* in, int in_h, int in_w, float* out, const float* residual,
                 ThreadPool& pool) const;
   void run_general(const float* in, int in_h, int in_w, float* out, const float* residual,
@@ -114,6 +126,8 @@ class Conv2d {
   // the row), group_stride_ floats apart, then [out_c] bias.
   // Taps: one pack_gemm_weights block without bias (column tap * out_c + j holds output
   // j's weights of one tap), group_stride_ floats, then [out_c] bias.
+  // Winograd: one pack_gemm_weights block without bias per transform position (the
+  // filters' U = G g G^T at that position), group_stride_ floats apart, then [out_c] bias.
   std::shared_ptr<const float> packed_;
   int64_t group_stride_ = 0;
 };

@@ -74,6 +74,22 @@ struct DepthwiseRowArgs {
   bool stream_out = false;
 };
 
+// One tile of a Winograd F(4x4, 3x3) convolution's output (kernels/winograd.h): the
+// 4x4 outputs Y = A^T M A of the 36 products M, plus bias, activation and residual.
+struct WinogradOutputArgs {
+  const float* m = nullptr;  // position xi's channels at m + xi * m_stride
+  int64_t m_stride = 0;
+  int channels = 0;
+  const float* bias = nullptr;      // [channels]
+  ActivationSpec act;
+  float* out = nullptr;             // output (y, x) at out + y * row_stride + x * channels
+  int64_t row_stride = 0;
+  const float* residual = nullptr;  // nullptr, or laid out like out
+  // The outputs inside the map: rows [0, rows) and columns [0, cols) of the tile, 1..4
+  // each; the others are not written.
+  int rows = 4, cols = 4;
+};
+
 // Which instruction set's code each entry of a table runs: the table's own variant, or
 // the one it falls back to (kernels/kernel_list.def says which ISA has which).
 struct KernelProviders {

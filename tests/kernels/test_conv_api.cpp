@@ -28,9 +28,12 @@ std::vector<ConvCase> one_case_per_path(uint32_t seed) {
   taps.p.in_c = 24;
   taps.p.out_c = 4;
   ConvCase rows = general;
-  rows.p.in_c = 12;
+  rows.p.in_c = 7;
   rows.p.out_c = 19;
-  std::vector<ConvCase> cases = {pointwise, depthwise, general, taps, rows};
+  ConvCase winograd = general;
+  winograd.p.in_c = 12;
+  winograd.p.out_c = 40;
+  std::vector<ConvCase> cases = {pointwise, depthwise, general, taps, rows, winograd};
   for (ConvCase& c : cases) c.seed = seed++;
   return cases;
 }
@@ -80,12 +83,25 @@ TEST_CASE("Conv2d picks the path by shape") {
   CHECK(path_of(cases[2].p) == Conv2d::Path::General);
   CHECK(path_of(cases[3].p) == Conv2d::Path::Taps);
   CHECK(path_of(cases[4].p) == Conv2d::Path::Rows);
+  CHECK(path_of(cases[5].p) == Conv2d::Path::Winograd);
   ConvParams five_outputs = cases[3].p;
   five_outputs.out_c = 5;
-  CHECK(path_of(five_outputs) == Conv2d::Path::Rows);
+  CHECK(path_of(five_outputs) == Conv2d::Path::Winograd);
   ConvParams strided_taps = cases[3].p;
   strided_taps.stride_h = 2;
   CHECK(path_of(strided_taps) == Conv2d::Path::Rows);
+  // Winograd: 3x3, stride 1, no dilation, one group, from 8 inputs.
+  ConvParams winograd = cases[5].p;
+  winograd.in_c = 8;
+  CHECK(path_of(winograd) == Conv2d::Path::Winograd);
+  winograd.in_c = 7;
+  CHECK(path_of(winograd) == Conv2d::Path::Rows);
+  winograd.in_c = 12;
+  winograd.dilation_h = 2;
+  CHECK(path_of(winograd) == Conv2d::Path::Rows);
+  winograd.dilation_h = 1;
+  winograd.kernel_w = 5;
+  CHECK(path_of(winograd) == Conv2d::Path::Rows);
   ConvParams grouped_taps = cases[3].p;
   grouped_taps.groups = 2;
   CHECK(path_of(grouped_taps) == Conv2d::Path::General);
