@@ -109,12 +109,22 @@ void resize_bicubic(const float* in, int h, int w, int c, int out_h, int out_w, 
 
 void resize_bilinear_corners(const float* in, int h, int w, int c, int out_h, int out_w, float* out,
                              ThreadPool& pool, const KernelTable& k) {
+  resize_bilinear_corners_rows(in, h, w, c, out_h, out_w, 0, out_h, out, pool, k);
+}
+
+void resize_bilinear_corners_rows(const float* in, int h, int w, int c, int out_h, int out_w, int row_begin,
+                                  int row_end, float* out, ThreadPool& pool, const KernelTable& k) {
   require_positive("resize_bilinear_corners", {h, w, c, out_h, out_w});
+  if (row_begin < 0 || row_end > out_h || row_begin >= row_end)
+    fail("resize_bilinear_corners: rows " + std::to_string(row_begin) + ".." + std::to_string(row_end) +
+         " are not inside 0.." + std::to_string(out_h));
   const LinearAxis ay = linear_corners_axis(out_h, h), ax = linear_corners_axis(out_w, w);
-  pool.parallel_for(out_h, 4, [&](int64_t y0, int64_t y1) {
-    for (int64_t y = y0; y < y1; ++y)
+  pool.parallel_for(row_end - row_begin, 4, [&](int64_t r0, int64_t r1) {
+    for (int64_t r = r0; r < r1; ++r) {
+      const int64_t y = row_begin + r;
       k.bilinear_row(in + size_t(ay.lo[y]) * w * c, in + size_t(ay.hi[y]) * w * c, ay.weight[y], ax.lo.data(),
-                     ax.hi.data(), ax.weight.data(), out_w, c, out + size_t(y) * out_w * c);
+                     ax.hi.data(), ax.weight.data(), out_w, c, out + size_t(r) * out_w * c);
+    }
   });
 }
 

@@ -41,6 +41,10 @@ void resize_bicubic(const float* in, int h, int w, int c, int out_h, int out_w, 
 // output coincide. Any sizes, up or down.
 void resize_bilinear_corners(const float* in, int h, int w, int c, int out_h, int out_w, float* out,
                              ThreadPool& pool = default_pool(), const KernelTable& k = kernels());
+// Rows [row_begin, row_end) of that resize only, into out [row_end - row_begin][out_w][c].
+void resize_bilinear_corners_rows(const float* in, int h, int w, int c, int out_h, int out_w, int row_begin,
+                                  int row_end, float* out, ThreadPool& pool = default_pool(),
+                                  const KernelTable& k = kernels());
 
 // DINOv2's position embedding for a rows x cols patch grid, from the pretrained one for a
 // grid x grid: pos [1 + grid*grid][dim] (row 0 the class token's) -> [1 + rows*cols][dim].

@@ -18,6 +18,9 @@ namespace {
 constexpr int64_t kFormatVersion = 1;
 constexpr int kTaps = 4;  // the DPT head reads four blocks
 constexpr int kMaxWorkingSize = 16384;
+// Rows per band of the output head (add_output_head): a multiple of Winograd's 4-row
+// tiles, so the bands tile the map as its whole convolution does.
+constexpr int kOutputBand = 4;
 
 [[noreturn]] void fail(const WeightFile& f, const std::string& problem) {
   throw std::runtime_error(f.path() + ": " + problem);
@@ -83,6 +86,28 @@ struct Fusion {
   Conv2d out_conv;
 };
 
+// One convolution with 'same' padding, run on a band of rows of its input that carries
+// kernel / 2 rows of context above and below: vertical padding only where the band
+// touches the map's top or bottom edge, so each band gives exactly the rows that the
+// whole map's convolution would (bitwise: the other paths, and Winograd's 4-row tiles
+// when bands start on multiples of 4, compute each output the same way).
+struct BandConvs {
+  static constexpr int kTop = 1, kBottom = 2;
+  Conv2d at_place[4];  // indexed by kTop | kBottom where the band touches that edge
+  const Conv2d& for_band(bool top, bool bottom) const { return at_place[(top ? kTop : 0) | (bottom ? kBottom : 0)]; }
+};
+
+ConvParams square_params(int in, int out, int kernel, Activation act, int stride) {
+  ConvParams p;
+  p.in_c = in;
+  p.out_c = out;
+  p.kernel_h = p.kernel_w = kernel;
+  p.stride_h = p.stride_w = stride;
+  p.pad_top = p.pad_left = p.pad_bottom = p.pad_right = kernel / 2;
+  p.act = {act};
+  return p;
+}
+
 // Weights are read by name with their shapes checked, and counted.
 class Reader {
  public:
@@ -103,14 +128,19 @@ class Reader {
     const Tensor w = tensor(name + ".weight", {out, kernel, kernel, in});
     Tensor b;
     if (bias) b = tensor(name + ".bias", {out});
-    ConvParams p;
-    p.in_c = in;
-    p.out_c = out;
-    p.kernel_h = p.kernel_w = kernel;
-    p.stride_h = p.stride_w = stride;
-    p.pad_top = p.pad_left = p.pad_bottom = p.pad_right = kernel / 2;
-    p.act = {act};
-    return Conv2d(p, w.f32(), bias ? b.f32() : nullptr, t_);
+    return Conv2d(square_params(in, out, kernel, act, stride), w.f32(), bias ? b.f32() : nullptr, t_);
+  }
+  // The same 'same'-padded convolution for each place of a band of rows (BandConvs).
+  BandConvs band_convs(const std::string& name, int in, int out, int kernel, Activation act) {
+    const Tensor w = tensor(name + ".weight", {out, kernel, kernel, in}), b = tensor(name + ".bias", {out});
+    BandConvs convs;
+    for (int place = 0; place < 4; ++place) {
+      ConvParams p = square_params(in, out, kernel, act, 1);
+      if (!(place & BandConvs::kTop)) p.pad_top = 0;
+      if (!(place & BandConvs::kBottom)) p.pad_bottom = 0;
+      convs.at_place[place] = Conv2d(p, w.f32(), b.f32(), t_);
+    }
+    return convs;
   }
   StridedTransposedConv transposed(const std::string& name, int channels, int stride) {
     const Tensor w = tensor(name + ".weight", {stride, stride, channels, channels});
@@ -154,7 +184,8 @@ struct DepthAnythingNet::Impl {
   Conv2d project[kTaps], layer_rn[kTaps], downsample;  // downsample: the coarsest level's resize
   StridedTransposedConv upsample4, upsample2;
   Fusion fusion[kTaps];  // fusion[k]: refinenet{k+1}
-  Conv2d output_conv1, head_hidden, head_out;
+  Conv2d output_conv1, head_out;
+  BandConvs head_hidden;
   int64_t params = 0;
   const KernelTable* table = nullptr;
 
@@ -173,6 +204,7 @@ struct DepthAnythingNet::Impl {
   int add_unit(Plan& p, const ResidualUnit& u, int x, int h, int w) const;
   int add_fusion(Plan& p, const Fusion& fu, int x, int skip, int h, int w, ImageSize to) const;
   int add_resize(Plan& p, int x, int h, int w, ImageSize to) const;
+  int add_output_head(Plan& p, int x, ImageSize fine, ImageSize shape) const;
 };
 
 DepthAnythingNet DepthAnythingNet::from_file(const WeightFile& f, const KernelTable& table) {
@@ -238,7 +270,7 @@ DepthAnythingNet DepthAnythingNet::from_file(const WeightFile& f, const KernelTa
   m->downsample = r.conv(head + "resize_layers.3", d.out_channels[3], d.out_channels[3], 3, true, Activation::None, 2);
   const int half = d.features / 2;
   m->output_conv1 = r.conv(s + "output_conv1", d.features, half, 3, true);
-  m->head_hidden = r.conv(s + "output_conv2.0", half, d.head_hidden, 3, true, Activation::ReLU);
+  m->head_hidden = r.band_convs(s + "output_conv2.0", half, d.head_hidden, 3, Activation::ReLU);
   m->head_out = r.conv(s + "output_conv2.2", d.head_hidden, 1, 1, true, Activation::ReLU);
   m->params = r.params();
   return DepthAnythingNet(std::move(m));
@@ -371,6 +403,32 @@ int DepthAnythingNet::Impl::add_fusion(Plan& p, const Fusion& fu, int x, int ski
   return add_conv(p, fu.out_conv, x, to.height, to.width);
 }
 
+// The head at the working size: the fine map resized bilinearly to it, a 3x3 convolution
+// with ReLU, a 1x1 convolution to one channel with ReLU (the final one too). Run in bands
+// of kOutputBand rows, each thread a band at a time, so the two working-size maps of
+// head_hidden channels (34 MB each for ViT-S at 518 x 518) only ever exist a band at a
+// time, in the thread's cache, instead of crossing memory twice.
+int DepthAnythingNet::Impl::add_output_head(Plan& p, int x, ImageSize fine, ImageSize shape) const {
+  const int y = p.produce(shape.height, shape.width, 1);
+  p.consume(x);
+  p.push([this, x, y, fine, shape](Plan& pl, ThreadPool& pool) {
+    const int height = shape.height, width = shape.width, c = d.features / 2;
+    const int bands = (height + kOutputBand - 1) / kOutputBand;
+    pool.parallel_for(bands, 1, [&](int64_t b0, int64_t b1) {  // the ops inside run on this thread
+      std::vector<float> resized(size_t(kOutputBand + 2) * width * c), hidden(size_t(kOutputBand) * width * d.head_hidden);
+      for (int64_t b = b0; b < b1; ++b) {
+        const int y0 = int(b) * kOutputBand, y1 = std::min(height, y0 + kOutputBand);
+        const int r0 = std::max(0, y0 - 1), r1 = std::min(height, y1 + 1);  // a row of context each side
+        resize_bilinear_corners_rows(pl.data(x), fine.height, fine.width, c, height, width, r0, r1, resized.data(),
+                                     pool, *table);
+        head_hidden.for_band(y0 == 0, y1 == height).run(resized.data(), r1 - r0, width, hidden.data(), nullptr, pool);
+        head_out.run(hidden.data(), y1 - y0, width, pl.data(y) + int64_t(y0) * width, nullptr, pool);
+      }
+    });
+  });
+  return y;
+}
+
 std::unique_ptr<Plan> DepthAnythingNet::Impl::build_plan(ImageSize shape) {
   auto p = std::make_unique<Plan>();
   const int rows = shape.height / d.patch, cols = shape.width / d.patch;
@@ -426,9 +484,7 @@ std::unique_ptr<Plan> DepthAnythingNet::Impl::build_plan(ImageSize shape) {
   }
   const ImageSize fine{2 * size[0].height, 2 * size[0].width};
   x = add_conv(*p, output_conv1, x, fine.height, fine.width);
-  x = add_resize(*p, x, fine.height, fine.width, shape);
-  x = add_conv(*p, head_hidden, x, shape.height, shape.width);
-  plan_output = add_conv(*p, head_out, x, shape.height, shape.width);  // its ReLU is the final one too
+  plan_output = add_output_head(*p, x, fine, shape);
   p->allocate("depth network (Depth Anything V2 " + variant + ") at " + std::to_string(shape.width) + "x" +
               std::to_string(shape.height));
   return p;

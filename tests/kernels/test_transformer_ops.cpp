@@ -176,6 +176,26 @@ TEST_CASE("resize_bilinear_corners matches the align_corners formula on every IS
         }
 }
 
+TEST_CASE("resize_bilinear_corners_rows gives exactly those rows of the whole resize") {
+  ThreadPool pool(2);
+  const int h = 7, w = 5, c = 9, oh = 23, ow = 11;
+  const std::vector<float> in = test::random_floats(size_t(h) * w * c, 1234);
+  std::vector<float> whole(size_t(oh) * ow * c);
+  resize_bilinear_corners(in.data(), h, w, c, oh, ow, whole.data(), pool);
+  for (int begin : {0, 1, 6, 22})
+    for (int end : {begin + 1, std::min(oh, begin + 4), oh}) {
+      INFO("rows " << begin << ".." << end);
+      test::GuardedOutput got(size_t(end - begin) * ow * c);
+      resize_bilinear_corners_rows(in.data(), h, w, c, oh, ow, begin, end, got.data(), pool);
+      CHECK(got.values() == std::vector<float>(whole.begin() + size_t(begin) * ow * c, whole.begin() + size_t(end) * ow * c));
+      CHECK(got.guard_intact());
+    }
+  std::vector<float> out(size_t(oh) * ow * c);
+  for (auto [begin, end] : {std::pair{-1, 3}, {3, 3}, {5, 2}, {0, oh + 1}})
+    CHECK_THROWS_WITH(resize_bilinear_corners_rows(in.data(), h, w, c, oh, ow, begin, end, out.data(), pool),
+                      Catch::Contains("are not inside 0..23"));
+}
+
 TEST_CASE("layer_norm over strided tokens matches the double reference on every ISA") {
   for (Isa isa : runnable_isas())
     for (ThreadPool* pool : test::thread_pools())
