@@ -385,6 +385,10 @@ int DepthAnythingNet::Impl::add_resize(Plan& p, int x, int h, int w, ImageSize t
 }
 
 // DPT fusion: (x + unit1(skip) when there is a skip), unit2, bilinear resize, 1x1 conv.
+// The 1x1 convolution runs before the resize instead, on a quarter of the pixels: both
+// are linear, and the resize's weights sum to one so the bias passes through, so the
+// order changes only the rounding (the fixtures hold either within 1e-4 of the range).
+// ViT-S at 518 x 518, 2 threads: the finest block's resize and 1x1 conv 2.4 -> 0.85 ms.
 int DepthAnythingNet::Impl::add_fusion(Plan& p, const Fusion& fu, int x, int skip, int h, int w,
                                        ImageSize to) const {
   if (skip >= 0) {
@@ -399,8 +403,8 @@ int DepthAnythingNet::Impl::add_fusion(Plan& p, const Fusion& fu, int x, int ski
     x = sum;
   }
   x = add_unit(p, fu.unit, x, h, w);
-  x = add_resize(p, x, h, w, to);
-  return add_conv(p, fu.out_conv, x, to.height, to.width);
+  x = add_conv(p, fu.out_conv, x, h, w);
+  return add_resize(p, x, h, w, to);
 }
 
 // The head at the working size: the fine map resized bilinearly to it, a 3x3 convolution
