@@ -49,6 +49,22 @@ inline float exp_polynomial(float x) {
   return (p * (r * r) + (r + 1.0f)) * two_to_n;
 }
 
+// 2^y for y <= 0 (below kExp2Min it returns 2^kExp2Min) by the vector exp2_nonpositive's
+// own steps, as exp_polynomial mirrors exp: the softmax's reference.
+inline float exp2_polynomial_nonpositive(float y) {
+  using namespace exp_poly;
+  y = std::max(y, kExp2Min);
+  constexpr float kRoundingShift = 12582912.0f;  // as above; |y| <= 126
+  const float n = (y + kRoundingShift) - kRoundingShift;
+  const float f = y - n;
+  float p = kExp2[0];
+  for (size_t i = 1; i < sizeof(kExp2) / sizeof(kExp2[0]); ++i) p = p * f + kExp2[i];
+  const uint32_t bits = static_cast<uint32_t>(static_cast<int32_t>(n) + 127) << 23;
+  float two_to_n;
+  std::memcpy(&two_to_n, &bits, sizeof two_to_n);
+  return p * two_to_n;
+}
+
 // gelu(x) = x Phi(x), Phi the standard normal CDF. Both signs go through the tail
 // h = Phi(-|x|) = erfc(|x| / sqrt 2) / 2, which keeps its relative accuracy where it is
 // tiny: Phi(x) = 1 - h for x >= 0, h for x < 0. h = exp(-x^2 / 2) Q(min(|x|, kMaxArg)),

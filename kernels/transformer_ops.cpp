@@ -237,9 +237,10 @@ PackedKeysValues pack_keys_values(const float* qkv, int tokens, int dim, int hea
   return kv;
 }
 
-// out rows [q0, q0 + qn) of one head: softmax(scale q k^T) v, streamed over the blocks of
+// out rows [q0, q0 + qn) of one head: softmax(q k^T) v with the softmax in base 2 and
+// scale_base2 = scale log2(e) (softmax_block_row), streamed over the blocks of
 // keys. scores holds kQueryBlock x kKeyBlock floats.
-void attend(const float* q, int64_t q_stride, int qn, const PackedKeysValues& kv, int head, float scale,
+void attend(const float* q, int64_t q_stride, int qn, const PackedKeysValues& kv, int head, float scale_base2,
             float* o, int64_t out_stride, float* scores, ThreadPool& pool, const KernelTable& k) {
   float running_max[kQueryBlock], running_sum[kQueryBlock];
   std::fill(running_max, running_max + qn, -INFINITY);
@@ -256,7 +257,7 @@ void attend(const float* q, int64_t q_stride, int qn, const PackedKeysValues& kv
     s.c_stride = kKeyBlock;
     gemm_packed(s, kv.at(head, 2 * b), pool, k);
     for (int r = 0; r < qn; ++r) {
-      const float factor = k.softmax_block_row(scores + size_t(r) * kKeyBlock, kn, scale, &running_max[r],
+      const float factor = k.softmax_block_row(scores + size_t(r) * kKeyBlock, kn, scale_base2, &running_max[r],
                                                &running_sum[r]);
       if (b > 0)
         for (int j = 0; j < kv.head_dim; ++j) o[r * out_stride + j] *= factor;
@@ -285,6 +286,8 @@ void self_attention(const float* qkv, int tokens, int dim, int heads, float scal
   if (tokens <= 0 || heads <= 0 || dim <= 0 || dim % heads || out_stride < dim)
     fail("self_attention: bad sizes (dim must split into the heads)");
   const PackedKeysValues kv = pack_keys_values(qkv, tokens, dim, heads, pool, k);
+  // softmax_block_row works in base 2: e^(scale s) = 2^(scale log2(e) s).
+  const float scale_base2 = float(double(scale) * 1.4426950408889634);
   const int64_t row = 3 * int64_t(dim);
   const int query_blocks = (tokens + kQueryBlock - 1) / kQueryBlock;
   // One task per head and block of queries; its products run on the calling thread (a
@@ -293,7 +296,7 @@ void self_attention(const float* qkv, int tokens, int dim, int heads, float scal
     std::vector<float> scores(size_t(kQueryBlock) * kKeyBlock);
     for (int64_t u = u0; u < u1; ++u) {
       const int head = int(u / query_blocks), q0 = int(u % query_blocks) * kQueryBlock;
-      attend(qkv + q0 * row + head * kv.head_dim, row, std::min(kQueryBlock, tokens - q0), kv, head, scale,
+      attend(qkv + q0 * row + head * kv.head_dim, row, std::min(kQueryBlock, tokens - q0), kv, head, scale_base2,
              out + q0 * out_stride + head * kv.head_dim, out_stride, scores.data(), pool, k);
     }
   });

@@ -93,20 +93,20 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   float32x4_t vsum = vdupq_n_f32(0.0f);
   j = 0;
   for (; j + 4 <= n; j += 4) {
-    const float32x4_t e = exp(vsubq_f32(vmulq_f32(vld1q_f32(scores + j), s), shift));
+    const float32x4_t e = exp2_nonpositive(vsubq_f32(vmulq_f32(vld1q_f32(scores + j), s), shift));
     vst1q_f32(scores + j, e);
     vsum = vaddq_f32(vsum, e);
   }
   if (j < n) {
     const int left = n - j;
     // Lanes past the block hold the exp of a 0 score: dropped from the sum.
-    const float32x4_t e = exp(vsubq_f32(vmulq_f32(load_tail(scores + j, left, 0.0f), s), shift));
+    const float32x4_t e = exp2_nonpositive(vsubq_f32(vmulq_f32(load_tail(scores + j, left, 0.0f), s), shift));
     store_tail(scores + j, left, e);
     static const int32_t kLane[4] = {0, 1, 2, 3};
     const uint32x4_t live = vcltq_s32(vld1q_s32(kLane), vdupq_n_s32(left));
     vsum = vaddq_f32(vsum, vreinterpretq_f32_u32(vandq_u32(live, vreinterpretq_u32_f32(e))));
   }
-  const float factor = old_max == -INFINITY ? 0.0f : vgetq_lane_f32(exp(vdupq_n_f32(old_max - new_max)), 0);
+  const float factor = old_max == -INFINITY ? 0.0f : vgetq_lane_f32(exp2_nonpositive(vdupq_n_f32(old_max - new_max)), 0);
   *running_sum = *running_sum * factor + vaddvq_f32(vsum);
   *running_max = new_max;
   return factor;

@@ -27,10 +27,10 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   const float shift = new_max == -INFINITY ? 0.0f : new_max;
   float sum = 0.0f;
   for (int j = 0; j < n; ++j) {
-    scores[j] = exp_polynomial(scores[j] * scale - shift);
+    scores[j] = exp2_polynomial_nonpositive(scores[j] * scale - shift);
     sum += scores[j];
   }
-  const float factor = old_max == -INFINITY ? 0.0f : exp_polynomial(old_max - new_max);
+  const float factor = old_max == -INFINITY ? 0.0f : exp2_polynomial_nonpositive(old_max - new_max);
   *running_sum = *running_sum * factor + sum;
   *running_max = new_max;
   return factor;

@@ -35,12 +35,15 @@ inline __m256 exp(__m256 x) {
 // 2^y for y <= 0 (below -126 it returns 2^-126). Cheaper than exp (no clamp from above,
 // no two-part range reduction): the slicer's bilateral weights, where it is the inner
 // loop, use it.
+// n = round(y) by the shifter and 2^n by the exponent add, as in exp: y >= -126 keeps
+// 2^n p normal.
 inline __m256 exp2_nonpositive(__m256 y) {
   y = _mm256_max_ps(y, _mm256_set1_ps(exp_poly::kExp2Min));
-  const __m256 n = _mm256_round_ps(y, _MM_FROUND_TO_NEAREST_INT | _MM_FROUND_NO_EXC);
-  const __m256 p = horner(exp_poly::kExp2, _mm256_sub_ps(y, n));
-  const __m256i e = _mm256_slli_epi32(_mm256_add_epi32(_mm256_cvtps_epi32(n), _mm256_set1_epi32(127)), 23);
-  return _mm256_mul_ps(p, _mm256_castsi256_ps(e));
+  const __m256 shifter = _mm256_set1_ps(12582912.0f);  // 1.5 * 2^23
+  const __m256 shifted = _mm256_add_ps(y, shifter);
+  const __m256 p = horner(exp_poly::kExp2, _mm256_sub_ps(y, _mm256_sub_ps(shifted, shifter)));
+  const __m256i exponent = _mm256_slli_epi32(_mm256_castps_si256(shifted), 23);
+  return _mm256_castsi256_ps(_mm256_add_epi32(_mm256_castps_si256(p), exponent));
 }
 
 inline __m256 sigmoid(__m256 x) {

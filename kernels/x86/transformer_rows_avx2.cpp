@@ -91,18 +91,18 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   __m256 vsum = _mm256_setzero_ps();
   int j = 0;
   for (; j + 8 <= n; j += 8) {
-    const __m256 e = exp(_mm256_sub_ps(_mm256_mul_ps(_mm256_loadu_ps(scores + j), s), shift));
+    const __m256 e = exp2_nonpositive(_mm256_sub_ps(_mm256_mul_ps(_mm256_loadu_ps(scores + j), s), shift));
     _mm256_storeu_ps(scores + j, e);
     vsum = _mm256_add_ps(vsum, e);
   }
   if (j < n) {
     const __m256i mask = tail_mask(n - j);
-    const __m256 e = exp(_mm256_sub_ps(_mm256_mul_ps(_mm256_maskload_ps(scores + j, mask), s), shift));
+    const __m256 e = exp2_nonpositive(_mm256_sub_ps(_mm256_mul_ps(_mm256_maskload_ps(scores + j, mask), s), shift));
     _mm256_maskstore_ps(scores + j, mask, e);
     vsum = _mm256_add_ps(vsum, _mm256_and_ps(e, _mm256_castsi256_ps(mask)));
   }
   const float factor =
-      old_max == -INFINITY ? 0.0f : _mm256_cvtss_f32(exp(_mm256_set1_ps(old_max - new_max)));
+      old_max == -INFINITY ? 0.0f : _mm256_cvtss_f32(exp2_nonpositive(_mm256_set1_ps(old_max - new_max)));
   *running_sum = *running_sum * factor + horizontal_sum(vsum);
   *running_max = new_max;
   return factor;

@@ -85,18 +85,18 @@ float softmax_block_row(float* scores, int n, float scale, float* running_max, f
   __m512 vsum = _mm512_setzero_ps();
   int j = 0;
   for (; j + 16 <= n; j += 16) {
-    const __m512 e = exp(_mm512_sub_ps(_mm512_mul_ps(_mm512_loadu_ps(scores + j), s), shift));
+    const __m512 e = exp2_nonpositive(_mm512_sub_ps(_mm512_mul_ps(_mm512_loadu_ps(scores + j), s), shift));
     _mm512_storeu_ps(scores + j, e);
     vsum = _mm512_add_ps(vsum, e);
   }
   if (j < n) {
     const __mmask16 mask = tail_mask(n - j);
-    const __m512 e = exp(_mm512_sub_ps(_mm512_mul_ps(_mm512_maskz_loadu_ps(mask, scores + j), s), shift));
+    const __m512 e = exp2_nonpositive(_mm512_sub_ps(_mm512_mul_ps(_mm512_maskz_loadu_ps(mask, scores + j), s), shift));
     _mm512_mask_storeu_ps(scores + j, mask, e);
     vsum = _mm512_mask_add_ps(vsum, mask, vsum, e);
   }
   const float factor =
-      old_max == -INFINITY ? 0.0f : _mm512_cvtss_f32(exp(_mm512_set1_ps(old_max - new_max)));
+      old_max == -INFINITY ? 0.0f : _mm512_cvtss_f32(exp2_nonpositive(_mm512_set1_ps(old_max - new_max)));
   *running_sum = *running_sum * factor + _mm512_reduce_add_ps(vsum);
   *running_max = new_max;
   return factor;

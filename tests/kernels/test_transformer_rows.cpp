@@ -120,7 +120,7 @@ TEST_CASE("layer_norm_row: every ISA matches the reference, in place too") {
 
 namespace {
 
-// Softmax of scores * scale over n keys streamed in blocks of `block` keys through one
+// Softmax (base 2) of scores * scale over n keys streamed in blocks of `block` keys through one
 // table's kernel, accumulating the probabilities as attention accumulates P V: the row
 // so far is multiplied by each block's factor, then divided by the sum at the end.
 std::vector<float> streamed_softmax(const KernelTable& k, std::vector<float> scores, float scale, int block) {
@@ -144,20 +144,20 @@ std::vector<int> softmax_lengths() {
 
 }  // namespace
 
-TEST_CASE("softmax_block_row streamed over blocks equals a one-shot softmax") {
+TEST_CASE("softmax_block_row streamed over blocks equals a one-shot softmax in base 2") {
   for (Isa isa : runnable_isas())
     for (int n : softmax_lengths())
       for (int block : {1, 7, 16, 64, n}) {
         const uint32_t seed = static_cast<uint32_t>(300 + n);
         INFO("isa " << isa_name(isa) << ", n " << n << ", block " << block << ", seed " << seed);
         const std::vector<float> scores = test::random_floats(n, seed, -40.0f, 40.0f);
-        const float scale = 0.125f;
+        const float scale = 0.125f * 1.442695f;  // attention's 1/sqrt(64), log2(e) folded in
         double max = -INFINITY, sum = 0.0;
         for (float s : scores) max = std::max(max, double(s) * scale);
-        for (float s : scores) sum += std::exp(double(s) * scale - max);
+        for (float s : scores) sum += std::exp2(double(s) * scale - max);
         const std::vector<float> got = streamed_softmax(kernels_for(isa), scores, scale, block);
         for (int j = 0; j < n; ++j) {
-          const double want = std::exp(double(scores[j]) * scale - max) / sum;
+          const double want = std::exp2(double(scores[j]) * scale - max) / sum;
           CHECK(std::fabs(got[j] - want) <= 1e-6 * (want + 1e-3));
         }
       }
@@ -182,7 +182,7 @@ TEST_CASE("softmax_block_row: every ISA matches the reference block by block") {
         CHECK(ulps_apart(got_factor, want_factor) <= 4.0f);
         // Summed in another order: the bound of n float additions of positive terms.
         CHECK(std::fabs(got_sum - want_sum) <= std::ldexp(float(8 + n), -24) * want_sum);
-        // exp(s_j - m) within a few ulp, plus what rounding s_j = scores[j] * scale and
+        // 2^(s_j - m) within a few ulp, plus what rounding s_j = scores[j] * scale and
         // s_j - m may move the exponent by: an ISA may fuse the two (one rounding where
         // the reference has two).
         for (int j = 0; j < n; ++j) {
