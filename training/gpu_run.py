@@ -1,52 +1,97 @@
-"""Depth training on a lent GPU machine, in runs of at most ten minutes that resume each
-other: pack what the runs need here, train there, bring the checkpoints back.
+"""Training on a lent GPU machine, in runs of at most ten minutes that resume each other:
+pack what the runs need here, train there, bring the checkpoints back. A run trains a
+depth network (lite, heavy: train_depth.py) or the inpainting network (inpaint:
+train_inpaint.py).
 
-    # here: the photos (downscaled), the ordinal set, each run's checkpoint and the script
-    /usr/bin/python3 training/gpu_run.py pack --run lite:training/runs/lite-gpu --run heavy:training/runs/heavy-gpu
+    # here: the photos (downscaled), the ordinal set, plane maps, each run's checkpoint, the script
+    /usr/bin/python3 training/gpu_run.py pack --run lite:training/runs/lite-gpu --run inpaint:training/runs/inpaint-gpu
     # there (the device tool's `run`, carry ["carry"]): bash carry/train.sh
     # here again: the files that came back into the run folders
-    /usr/bin/python3 training/gpu_run.py unpack FILES_AT --run lite:training/runs/lite-gpu --run heavy:training/runs/heavy-gpu
+    /usr/bin/python3 training/gpu_run.py unpack FILES_AT --run lite:training/runs/lite-gpu \\
+        --run inpaint:training/runs/inpaint-gpu
 
 The GPU machine gets only the working tree and the carried folder (64 MiB in all), not
 ../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the
 same folder and file names, so the train/validation splits are the same there, and the
-ordinal set with its points scaled to those sizes. The runs train side by side on the one
-GPU, the machine's cores shared out among their DataLoader workers that make the scenes;
-the GPU outruns the scene renderer, so each scene batch trains --scene-reuse steps
+ordinal set with its points scaled to those sizes. The inpainting run trains on the same
+photos, so at most 384 px there against inpaint_data.MAX_SIDE = 768 here: a photo of 768
+px or more is seen at half the scale. For each photo with a cached disparity map
+(--disparity-dir) it gets the plane map its slicing would make of that map at the carried
+size (inpaint_data.write_planes; the maps themselves would not fit); the others get the
+stand-in there as here. `pack` prints what each part of the transfer takes and fails,
+naming them, when the working tree and carry/ come to more than 64 MiB.
+
+The runs train side by side on the one GPU, the machine's cores shared out equally among
+their DataLoader workers (scenes for depth, crops and their prefill for inpainting); the
+GPU outruns the scene renderer, so each depth scene batch trains --scene-reuse steps
 (augmented after the first). --minutes stops each run validated and checkpointed inside
-the command's limit; validation measures an exponential moving average of the weights
-(--ema). Checkpoints cross slim: no Adam moments, the average as the weights, in half
-precision (a returned file may have 16 MiB, all of them 64 MiB; heavy's weights alone are
-25 MB in fp32): the run resumes with those weights, its step, schedule and learning rate,
-and Adam's moments start again. `unpack` puts checkpoint.pt (and best.pt, when the GPU run
-beat the best so far) into each run folder and appends the run's log to its train.log, so
-the next `pack` resumes where the GPU stopped, here or there.
+the command's limit; depth validation measures an exponential moving average of the
+weights (--ema); --lr-decay cosine --decay-steps N gives the depth runs a learning rate
+that falls with the step (train_depth.cosine_lr) instead of x0.2 on a plateau.
+
+Checkpoints cross slim, without Adam's moments (a returned file may have 16 MiB, all of
+them 64 MiB). A depth checkpoint carries the average as the weights, in half precision
+(heavy's weights alone are 25 MB in fp32), its step, schedule and learning rate; an
+inpainting checkpoint keeps its two small networks in fp32. Each run resumes with those
+weights and its step, and Adam's moments start again. `unpack` puts the checkpoint
+(checkpoint.pt; inpainting's last.pt) and best.pt, when the GPU run beat the best so far,
+into each run folder and appends the run's logs to its own (train.log; inpainting's
+log.csv too, without a second header), so the next `pack` resumes where the GPU stopped,
+here or there.
 """
 from __future__ import annotations
 
 import argparse
 import json
+import shlex
 import shutil
 import sys
+from dataclasses import dataclass
 from pathlib import Path
 
 from PIL import Image, ImageOps
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import depth_model  # noqa: E402
+import inpaint_data  # noqa: E402
 import photo_folder  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 PHOTO_LONG_SIDE = 384
 TRANSFER_LIMIT = 64 * 2 ** 20   # the device tool's working tree, carried folder included
 ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
+INPAINT = "inpaint"
+NETWORKS = (*depth_model.ARCHITECTURES, INPAINT)   # what --run NAME:DIR may name
+INPAINT_ARGS = "--batch 32 --crop 96 --lr-g 4e-4 --lr-d 2e-4 --validate-every 250 --checkpoint-every 250"
 
+
+@dataclass(frozen=True)
+class RunFiles:
+    checkpoint: str    # the resumable checkpoint in the run folder
+    logs: tuple        # the logs unpack appends to the run folder's own
+
+
+DEPTH_FILES = RunFiles("checkpoint.pt", ("train.log",))
+INPAINT_FILES = RunFiles("last.pt", ("train.log", "log.csv"))
+
+
+def run_files(name: str) -> RunFiles:
+    return INPAINT_FILES if name == INPAINT else DEPTH_FILES
+
+
+# ---- checkpoints ----------------------------------------------------------------------------
 
 def slim_checkpoint(source: Path, target: Path):
-    """The checkpoint without Adam's moments, with the learning rate, and its floating-point
-    weights (the average's, when the run keeps one) in half precision where they fit: what
-    crosses to the GPU machine and back."""
+    """What crosses to the GPU machine and back: the checkpoint without Adam's moments (an
+    inpainting one has a generator, a depth one a model)."""
     import torch
     ckpt = torch.load(source, map_location="cpu", weights_only=False)  # our own file, from any torch
+    torch.save(slim_inpaint(ckpt) if "generator" in ckpt else slim_depth(ckpt), target)
+
+
+def slim_depth(ckpt: dict) -> dict:
+    """A depth checkpoint with the learning rate and its floating-point weights (the
+    average's, when the run keeps one) in half precision where they fit."""
     slim = {k: v for k, v in ckpt.items() if k != "optimiser"}
     # With a weight average (train_depth.py --ema) the average crosses as the weights: two
     # sets would not fit (heavy's alone is 12.6 MB in fp16), and a run resumed from its
@@ -55,7 +100,14 @@ def slim_checkpoint(source: Path, target: Path):
     slim["model"] = {name: half_if_exact_enough(t) for name, t in weights.items()}
     if "optimiser" in ckpt:
         slim["lr"] = ckpt["optimiser"]["param_groups"][0]["lr"]
-    torch.save(slim, target)
+    return slim
+
+
+def slim_inpaint(ckpt: dict) -> dict:
+    """An inpainting checkpoint without its optimisers. Both networks stay fp32: together
+    they are 1.6 MB, so half precision would save little and cost the generator's small
+    residual its exactness."""
+    return {k: v for k, v in ckpt.items() if k not in ("opt_g", "opt_d")}
 
 
 def half_if_exact_enough(tensor):
@@ -65,6 +117,8 @@ def half_if_exact_enough(tensor):
         return tensor
     return tensor.half()
 
+
+# ---- pack -----------------------------------------------------------------------------------
 
 def pack_photos(out: Path):
     """Every photo at most PHOTO_LONG_SIDE, as JPEG under its own relative name; returns
@@ -96,65 +150,104 @@ def scaled_ordinal_set(ordinal: Path, sizes) -> dict:
     return data
 
 
+def pack_planes(out: Path, sizes, disparity_dir: str) -> int:
+    """The plane map of every photo with a cached disparity map, at its carried size (the
+    maps themselves would take several times the room); returns how many."""
+    count = 0
+    for rel, (_, _, w, h) in sizes.items():
+        source = Path(inpaint_data.disparity_path(disparity_dir, rel))
+        if source.exists():
+            inpaint_data.write_planes(str(source), (w, h), inpaint_data.disparity_path(str(out), rel))
+            count += 1
+    return count
+
+
 def parse_runs(specs):
-    """--run MODEL:DIR, repeated: [(model, Path)]."""
+    """--run NAME:DIR, repeated: [(name, Path)]."""
     runs = []
     for spec in specs:
-        model, sep, folder = spec.partition(":")
-        if not sep or not folder:
-            raise SystemExit(f"--run {spec}: expected MODEL:DIR, e.g. lite:training/runs/lite-gpu")
-        runs.append((model, Path(folder)))
-    if len({model for model, _ in runs}) != len(runs):
-        raise SystemExit("--run: one run per model")
+        name, sep, folder = spec.partition(":")
+        if not sep or not folder or name not in NETWORKS:
+            raise SystemExit(f"--run {spec}: expected NAME:DIR with NAME one of {', '.join(NETWORKS)}, "
+                             f"e.g. lite:training/runs/lite-gpu")
+        runs.append((name, Path(folder)))
+    if len({name for name, _ in runs}) != len(runs):
+        raise SystemExit("--run: one run per network")
     return runs
 
 
-def train_script(args, models) -> str:
-    """The shell script the GPU machine runs from the repository's root: every run's
-    training side by side, then its slim checkpoint, best weights and log into $OUT/MODEL/.
-    A first run starts from the bundled weights; later ones resume the carried checkpoint
-    (--init is then ignored)."""
-    c, workers = args.carry, max(1, args.workers // len(models))
-    lines = ["#!/bin/bash", "# written by training/gpu_run.py pack", "set -u",
-             f"export AMPI_PHOTO_ROOT={c}/photos PYTHONUNBUFFERED=1", "pids=()"]
-    for model in models:
-        lines.append(
-            f"{args.python} training/train_depth.py --model {model} --run {c}/{model} --data scenes "
+def depth_command(args, model: str, workers: int) -> str:
+    """A first run starts from the bundled weights; later ones resume the carried
+    checkpoint (--init is then ignored)."""
+    c = args.carry
+    decay = f" --lr-decay cosine --decay-steps {args.decay_steps}" if args.lr_decay == "cosine" else ""
+    return (f"{args.python} training/train_depth.py --model {model} --run {c}/{model} --data scenes "
             f"--size {args.size} --batch {args.batch} --init weights/depth_{model}.ampw --steps 10000000 "
             f"--device {args.device} --threads {args.threads} --workers {workers} --scene-reuse {args.scene_reuse} "
-            f"--ema {args.ema} "
+            f"--ema {args.ema}{decay} "
             f"--minutes {args.minutes} --val-every {args.val_every} --val-count {args.val_count} "
-            f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
-            f"> {c}/{model}/console.txt 2>&1 & pids+=($!)")
+            f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch}")
+
+
+def inpaint_command(args, workers: int) -> str:
+    """A first run starts from the bundled generator, with the bundled lite depth
+    network's encoder as its perceptual features; --inpaint-args come last, so they
+    override."""
+    c = args.carry
+    return (f"{args.python} training/train_inpaint.py --run-dir {c}/{INPAINT} --photos {c}/photos "
+            f"--planes-dir {c}/inpaint_planes --init weights/inpaint.ampw --perceptual weights/depth_lite.ampw "
+            f"--device {args.device} --threads {args.threads} --workers {workers} --minutes {args.minutes} "
+            f"{shlex.join(shlex.split(args.inpaint_args))}")
+
+
+def train_script(args, names) -> str:
+    """The shell script the GPU machine runs from the repository's root: every run's
+    training side by side, then its slim checkpoint, best weights and logs into $OUT/NAME/."""
+    c, workers = args.carry, max(1, args.workers // len(names))
+    lines = ["#!/bin/bash", "# written by training/gpu_run.py pack", "set -u",
+             f"export AMPI_PHOTO_ROOT={c}/photos PYTHONUNBUFFERED=1", "pids=()"]
+    for name in names:
+        command = inpaint_command(args, workers) if name == INPAINT else depth_command(args, name, workers)
+        lines.append(f"{command} > {c}/{name}/console.txt 2>&1 & pids+=($!)")
     lines.append("status=0; for pid in \"${pids[@]}\"; do wait $pid || status=1; done")
-    for model in models:
-        lines += [f"mkdir -p $OUT/{model}; tail -n 20 {c}/{model}/console.txt",
-                  f"cp {c}/{model}/train.log $OUT/{model}/ 2>/dev/null",
-                  f"[ -f {c}/{model}/checkpoint.pt ] && {args.python} training/gpu_run.py slim "
-                  f"{c}/{model}/checkpoint.pt $OUT/{model}/checkpoint.pt",
-                  f"[ -f {c}/{model}/best.pt ] && {args.python} training/gpu_run.py slim "
-                  f"{c}/{model}/best.pt $OUT/{model}/best.pt"]
+    for name in names:
+        files = run_files(name)
+        lines += [f"mkdir -p $OUT/{name}; tail -n 20 {c}/{name}/console.txt"]
+        lines += [f"cp {c}/{name}/{log} $OUT/{name}/ 2>/dev/null" for log in files.logs]
+        lines += [f"[ -f {c}/{name}/{ckpt} ] && {args.python} training/gpu_run.py slim "
+                  f"{c}/{name}/{ckpt} $OUT/{name}/{ckpt}" for ckpt in (files.checkpoint, "best.pt")]
     lines.append("exit $status")
     return "\n".join(lines) + "\n"
 
 
+def size_of(path: Path) -> int:
+    return sum(f.stat().st_size for f in path.rglob("*") if f.is_file()) if path.is_dir() else path.stat().st_size
+
+
 def cmd_pack(args):
     carry, runs = Path(args.carry), parse_runs(args.run)
+    if args.lr_decay == "cosine" and args.decay_steps <= 0:
+        raise SystemExit("gpu_run.py pack: --lr-decay cosine needs --decay-steps N (N > 0)")
     if carry.exists():
         shutil.rmtree(carry)
     sizes = pack_photos(carry / "photos")
     (carry / "ordinal.json").write_text(json.dumps(scaled_ordinal_set(args.ordinal, sizes)))
-    for model, run in runs:
-        (carry / model).mkdir(parents=True)
-        if (run / "checkpoint.pt").exists():  # best.pt stays here: the GPU writes one only if it beats it
-            slim_checkpoint(run / "checkpoint.pt", carry / model / "checkpoint.pt")
-    (carry / "train.sh").write_text(train_script(args, [model for model, _ in runs]))
-    carried = sum(f.stat().st_size for f in carry.rglob("*") if f.is_file())
+    planes = pack_planes(carry / "inpaint_planes", sizes, args.disparity_dir) if INPAINT in dict(runs) else 0
+    for name, run in runs:
+        (carry / name).mkdir(parents=True)
+        checkpoint = run_files(name).checkpoint
+        if (run / checkpoint).exists():  # best.pt stays here: the GPU writes one only if it beats it
+            slim_checkpoint(run / checkpoint, carry / name / checkpoint)
+    (carry / "train.sh").write_text(train_script(args, [name for name, _ in runs]))
+    parts = {part.name: size_of(part) for part in sorted(carry.iterdir())}
     tree = tracked_bytes()
-    print(f"{carry}: {len(sizes)} photos, the ordinal set, {len(runs)} runs; {carried / 2 ** 20:.1f} MiB, "
-          f"{(carried + tree) / 2 ** 20:.1f} MiB with the working tree")
-    if carried + tree > TRANSFER_LIMIT:
-        raise SystemExit(f"{carry}: the working tree and carry/ come to more than the device tool's "
+    total = tree + sum(parts.values())
+    shown = f"the working tree {tree / 2 ** 20:.1f}, " + ", ".join(
+        f"{name} {size / 2 ** 20:.1f}" for name, size in parts.items())
+    print(f"{carry}: {len(sizes)} photos, the ordinal set, {planes} plane maps, {len(runs)} runs; "
+          f"{total / 2 ** 20:.1f} MiB in all ({shown})")
+    if total > TRANSFER_LIMIT:
+        raise SystemExit(f"{carry}: {total / 2 ** 20:.1f} MiB in all ({shown}), more than the device tool's "
                          f"{TRANSFER_LIMIT // 2 ** 20} MiB")
     print(f"device command (carry [\"{args.carry}\"]):")
     print(f"bash {args.carry}/train.sh")
@@ -166,56 +259,84 @@ def tracked_bytes() -> int:
     return sum((ROOT / n).stat().st_size for n in names.decode().split("\0") if n and (ROOT / n).is_file())
 
 
+# ---- slim, unpack ---------------------------------------------------------------------------
+
 def cmd_slim(args):
     slim_checkpoint(Path(args.source), Path(args.target))
 
 
+def append_log(source: Path, target: Path):
+    """source's lines at the end of target, less a first line target starts with too
+    (log.csv's header)."""
+    lines = source.read_text().splitlines(keepends=True)
+    if lines and target.exists():
+        with open(target) as existing:
+            if existing.readline() == lines[0]:
+                lines = lines[1:]
+    with open(target, "a") as log:
+        log.writelines(lines)
+
+
 def cmd_unpack(args):
     came_back, runs = Path(args.files_at), parse_runs(args.run)
-    for model, _ in runs:
-        missing = [name for name in ("checkpoint.pt", "train.log") if not (came_back / model / name).exists()]
+    for name, _ in runs:
+        files = run_files(name)
+        missing = [f for f in (files.checkpoint, *files.logs) if not (came_back / name / f).exists()]
         if missing:
-            raise SystemExit(f"{came_back}/{model}: {', '.join(missing)} did not come back; "
+            raise SystemExit(f"{came_back}/{name}: {', '.join(missing)} did not come back; "
                              f"the run folders are unchanged")
-    for model, run in runs:
+    for name, run in runs:
+        files = run_files(name)
         run.mkdir(parents=True, exist_ok=True)
-        copied = [name for name in ("checkpoint.pt", "best.pt") if (came_back / model / name).exists()]
-        for name in copied:
-            shutil.copyfile(came_back / model / name, run / name)  # writable, unlike what came back
-        with open(run / "train.log", "a") as log:
-            log.write((came_back / model / "train.log").read_text())
-        print(f"{run}: {' and '.join(copied)} from {came_back}/{model}, its log appended to train.log")
+        copied = [f for f in (files.checkpoint, "best.pt") if (came_back / name / f).exists()]
+        for f in copied:
+            shutil.copyfile(came_back / name / f, run / f)  # writable, unlike what came back
+        for log in files.logs:
+            append_log(came_back / name / log, run / log)
+        print(f"{run}: {' and '.join(copied)} from {came_back}/{name}, {' and '.join(files.logs)} appended")
 
 
-def main():
+def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True)
-    pack = sub.add_parser("pack", help="photos, ordinal set and checkpoint into carry/")
+    pack = sub.add_parser("pack", help="photos, ordinal set, plane maps and checkpoints into carry/")
     pack.add_argument("--run", action="append", required=True,
-                      help="MODEL:DIR, repeatable: a model to train and its run folder (may be new)")
+                      help="NAME:DIR, repeatable: a network to train (lite, heavy, inpaint) and its run "
+                           "folder (may be new)")
     pack.add_argument("--carry", default="carry", help="the folder to fill, relative to the repository root")
     pack.add_argument("--ordinal", default=str(ORDINAL))
     pack.add_argument("--device", default="cuda")
     pack.add_argument("--python", default="python3", help="the GPU machine's Python (the one with PyTorch)")
     pack.add_argument("--threads", type=int, default=1, help="CPU threads of each training process")
     pack.add_argument("--workers", type=int, default=15,
-                      help="scene-making processes, shared out among the runs (the machine has 16 cores)")
-    pack.add_argument("--scene-reuse", type=int, default=4, help="steps each rendered scene batch trains")
-    pack.add_argument("--ema", type=float, default=0.999,
-                      help="decay of the weight average that validation measures (0: none)")
-    pack.add_argument("--val-count", type=int, default=32)
-    pack.add_argument("--size", default="256x192")
-    pack.add_argument("--batch", type=int, default=48)
-    pack.add_argument("--ordinal-batch", type=int, default=16)
+                      help="batch-making processes, shared out equally among the runs (the machine has 16 cores)")
     pack.add_argument("--minutes", type=float, default=8.0, help="training time of one device run")
-    pack.add_argument("--val-every", type=int, default=500)
-    unpack = sub.add_parser("unpack", help="the files that came back into the run folder")
+    depth = pack.add_argument_group("depth runs")
+    depth.add_argument("--scene-reuse", type=int, default=4, help="steps each rendered scene batch trains")
+    depth.add_argument("--ema", type=float, default=0.999,
+                       help="decay of the weight average that validation measures (0: none)")
+    depth.add_argument("--lr-decay", choices=("none", "cosine"), default="none",
+                       help="none: lr x0.2 on a plateau; cosine: lr falls by the step (train_depth.py)")
+    depth.add_argument("--decay-steps", type=int, default=0,
+                       help="with --lr-decay cosine: the step (from the run's start) where lr reaches its floor")
+    depth.add_argument("--val-count", type=int, default=32)
+    depth.add_argument("--size", default="256x192")
+    depth.add_argument("--batch", type=int, default=48)
+    depth.add_argument("--ordinal-batch", type=int, default=16)
+    depth.add_argument("--val-every", type=int, default=500)
+    inpaint = pack.add_argument_group("the inpainting run")
+    inpaint.add_argument("--disparity-dir", default=inpaint_data.DEFAULT_DISPARITY_DIR,
+                         help="cached disparity maps (inpaint_data.py --write-disparity) to carry as plane maps")
+    inpaint.add_argument("--inpaint-args", default=INPAINT_ARGS,
+                         help="more train_inpaint.py options, one string (write --inpaint-args=\"...\"); "
+                              "they override pack's")
+    unpack = sub.add_parser("unpack", help="the files that came back into the run folders")
     unpack.add_argument("files_at")
-    unpack.add_argument("--run", action="append", required=True, help="MODEL:DIR, as given to pack")
+    unpack.add_argument("--run", action="append", required=True, help="NAME:DIR, as given to pack")
     slim = sub.add_parser("slim", help="a checkpoint without Adam's moments")
     slim.add_argument("source")
     slim.add_argument("target")
-    args = p.parse_args()
+    args = p.parse_args(argv)
     {"pack": cmd_pack, "unpack": cmd_unpack, "slim": cmd_slim}[args.command](args)
 
 

@@ -19,6 +19,9 @@ DISPARITY_DIR/<relative path>.png, written by `python3 training/inpaint_data.py
 --write-disparity --ampi build-i/ampi`. A photo without one gets the stand-in of
 `standin_disparity` (documented in training/INPAINT.md): a smooth blend of a vertical ramp
 and of blurred colour, so layer contours follow image edges as real depth edges do.
+A plane map under PLANES_DIR/<relative path>.png (written by `write_planes`: what
+training/gpu_run.py carries to a GPU machine) replaces both: the photo's slicing done
+ahead, at the photo's size.
 
 Slicing here is a numpy port of the paper's transition selection (slicing/adaptive.h:
 eps 0.001, xi 8, threshold 0.1, at most 8 planes), with a box blur and a gradient-magnitude
@@ -203,9 +206,44 @@ def photo_disparity(root: str, rel: str, disparity_dir: str, rgb: np.ndarray) ->
     return standin_disparity(rgb, standin_seed(rel))
 
 
-def prepare_photo(root: str, rel: str, disparity_dir: str) -> Photo:
+def write_planes(disparity_file: str, size, out: str):
+    """The plane map that prepare_photo slices from a cached disparity map for a photo of
+    size (w, h), as an 8-bit PNG: what crosses to a GPU machine instead of the map (a few
+    KB of plane indices compress far better than the map's smooth levels)."""
+    labels = slice_labels(load_disparity(disparity_file, size))
+    os.makedirs(os.path.dirname(out), exist_ok=True)
+    Image.fromarray(labels).save(out, optimize=True)
+
+
+def load_planes(path: str, shape) -> np.ndarray:
+    """A plane map of write_planes for a photo of shape (h, w)."""
+    with Image.open(path) as im:
+        labels = np.asarray(im, dtype=np.uint8)
+    if labels.shape != tuple(shape):
+        raise ValueError(f"{path}: a {labels.shape[1]}x{labels.shape[0]} plane map for a "
+                         f"{shape[1]}x{shape[0]} photo")
+    return labels
+
+
+def planes_file(planes_dir: str | None, rel: str) -> str | None:
+    """The photo's plane map under planes_dir (laid out as the disparity cache), if any."""
+    path = disparity_path(planes_dir, rel) if planes_dir else None
+    return path if path and os.path.exists(path) else None
+
+
+def has_depth(rel: str, disparity_dir: str, planes_dir: str | None) -> bool:
+    """Whether the photo is sliced by our depth network (its plane map or a cached
+    disparity map), not by the stand-in."""
+    return planes_file(planes_dir, rel) is not None or os.path.exists(disparity_path(disparity_dir, rel))
+
+
+def prepare_photo(root: str, rel: str, disparity_dir: str, planes_dir: str | None = None) -> Photo:
     rgb = load_photo(os.path.join(root, rel))
-    labels = slice_labels(photo_disparity(root, rel, disparity_dir, rgb))
+    planes = planes_file(planes_dir, rel)
+    if planes:
+        labels = load_planes(planes, rgb.shape[:2])
+    else:
+        labels = slice_labels(photo_disparity(root, rel, disparity_dir, rgb))
     return Photo(rel, rgb, labels, int(labels.max()) + 1)
 
 
@@ -293,14 +331,15 @@ class SampleSource:
         return tuple(torch.stack(t) for t in zip(*(self.sample(rng) for _ in range(size))))
 
 
-def prepare_photos(root: str, rels, disparity_dir: str, log=print, standin_too: bool = False):
-    """One Photo per path, sliced with its cached disparity (the stand-in without one);
-    standin_too adds a second Photo sliced with the stand-in where a cached map exists,
-    so the network sees both kinds of plane contours."""
+def prepare_photos(root: str, rels, disparity_dir: str, log=print, standin_too: bool = False,
+                   planes_dir: str | None = None):
+    """One Photo per path, sliced with its plane map or cached disparity (the stand-in
+    without either); standin_too adds a second Photo sliced with the stand-in where the
+    photo has depth, so the network sees both kinds of plane contours."""
     photos, standins = [], 0
     for rel in rels:
-        photos.append(prepare_photo(root, rel, disparity_dir))
-        cached = os.path.exists(disparity_path(disparity_dir, rel))
+        photos.append(prepare_photo(root, rel, disparity_dir, planes_dir))
+        cached = has_depth(rel, disparity_dir, planes_dir)
         standins += not cached
         if standin_too and cached:
             rgb = photos[-1].rgb

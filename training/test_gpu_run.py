@@ -1,7 +1,14 @@
 """The GPU round trip of training/gpu_run.py, at a tiny size on the CPU: pack a photo
-folder, an ordinal set and a run into a carry folder, run the device command there (with
---device cpu), unpack what it wrote to $OUT, and do it again: the second run resumes."""
+folder, an ordinal set, disparity maps and two runs (lite, inpaint) into a carry folder,
+run the device command there (with --device cpu), unpack what it wrote to $OUT, and do it
+again: the second runs resume. pack's refusal of more than the device tool carries. And
+train_depth.py's cosine learning-rate decay: its values, and a run resumed from a slim
+checkpoint continuing the curve."""
+import argparse
+import contextlib
+import io
 import json
+import re
 import os
 import shutil
 import subprocess
@@ -9,6 +16,7 @@ import sys
 import tempfile
 import unittest
 from pathlib import Path
+from unittest import mock
 
 import numpy as np
 import torch
@@ -17,6 +25,10 @@ from PIL import Image
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 PYTHON = sys.executable
+sys.path.insert(0, str(HERE))
+import gpu_run  # noqa: E402
+import inpaint_data  # noqa: E402
+import train_depth  # noqa: E402
 
 
 def make_photos(root: Path):
@@ -34,6 +46,17 @@ def make_photos(root: Path):
     (root / "ordinal.json").write_text(json.dumps({"photos": entries}))
 
 
+def make_disparity(folder: Path):
+    """A 16-bit disparity map for every photo of make_photos, laid out as the inpainting
+    data's cache: three bands and a disc, which slice into planes."""
+    yy, xx = np.mgrid[0:300, 0:900]
+    disparity = 10000 + 20000 * (yy // 100) + 12000 * ((xx - 450) ** 2 + (yy - 150) ** 2 < 60 ** 2)
+    for i in range(10):
+        path = Path(inpaint_data.disparity_path(str(folder), f"set/p{i}.jpg"))
+        path.parent.mkdir(parents=True, exist_ok=True)
+        Image.fromarray(disparity.astype(np.uint16)).save(path)
+
+
 class RoundTrip(unittest.TestCase):
     def run_tool(self, *args, env=None):
         result = subprocess.run([PYTHON, str(HERE / "gpu_run.py"), *args], cwd=ROOT, env=env,
@@ -45,20 +68,28 @@ class RoundTrip(unittest.TestCase):
         with tempfile.TemporaryDirectory() as folder:
             tmp = Path(folder)
             make_photos(tmp)
+            make_disparity(tmp / "disparity")
             env = dict(os.environ, AMPI_PHOTO_ROOT=str(tmp / "photos"))
             carry, out = tmp / "carry", tmp / "out"
-            runs = {"lite": tmp / "lite", "heavy": tmp / "heavy"}
+            # heavy trains by lite's code; its 12 MiB checkpoint beside these would pass the 64 MiB
+            runs = {"lite": tmp / "lite", "inpaint": tmp / "inpaint"}
             run_args = [arg for model, run in runs.items() for arg in ("--run", f"{model}:{run}")]
             for round_trip in range(2):
                 printed = self.run_tool("pack", *run_args, "--carry", str(carry), "--ordinal",
                                         str(tmp / "ordinal.json"), "--device", "cpu", "--python", PYTHON, "--size", "64x64",
                                         "--batch", "2", "--ordinal-batch", "2", "--minutes", "0.05",
-                                        "--threads", "1", "--workers", "2", "--scene-reuse", "2", "--val-count", "2", env=env)
+                                        "--threads", "1", "--workers", "2", "--scene-reuse", "2", "--val-count", "2",
+                                        "--lr-decay", "cosine", "--decay-steps", "1000",
+                                        "--disparity-dir", str(tmp / "disparity"),
+                                        "--inpaint-args=--max-photos 3 --batch 2 --crop 64 --log-every 2 "
+                                        "--validate-every 2 --checkpoint-every 2", env=env)
                 packed = json.loads((carry / "ordinal.json").read_text())["photos"][0]
                 self.assertEqual((packed["width"], packed["height"]), (384, 128))   # scaled to 384 px
                 with Image.open(carry / "photos" / "set" / "p0.jpg") as photo:
                     self.assertEqual(photo.size, (384, 128))
                 self.assertLess(packed["pairs"][0]["b"][0], 384)
+                self.check_plane_map(carry, tmp / "disparity")
+                self.assertIn("--lr-decay cosine --decay-steps 1000", (carry / "train.sh").read_text())
                 command = printed.strip().splitlines()[-1]
                 shutil.rmtree(out, ignore_errors=True)
                 out.mkdir()
@@ -66,21 +97,62 @@ class RoundTrip(unittest.TestCase):
                                       capture_output=True, text=True)
                 self.assertEqual(done.returncode, 0, done.stdout + done.stderr)
                 self.run_tool("unpack", str(out), *run_args)
-                for model, run in runs.items():
-                    for name in ("checkpoint.pt", "best.pt", "train.log"):
-                        self.assertTrue((run / name).exists(), f"{model} {name}")
-                    back = torch.load(out / model / "checkpoint.pt")
-                    self.assertNotIn("optimiser", back)   # slim: under the 16 MiB a returned file may have
-                    self.assertIn("lr", back)
-                    self.assertEqual(next(iter(back["model"].values())).dtype, torch.float16)
-                    self.assertNotIn("ema", back)   # --ema 0.999: the average crosses as the weights
-            for model, run in runs.items():
-                log = (run / "train.log").read_text()
-                self.assertIn(f"initialised {model} from weights/depth_{model}.ampw", log)
-                self.assertIn("(slim: Adam restarts)", log)
-                self.assertIn("weights averaged (decay 0.999)", log)
-                self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
-                self.assertIn("ordinal_whdr", log)
+                for name in ("checkpoint.pt", "best.pt", "train.log"):
+                    self.assertTrue((runs["lite"] / name).exists(), f"lite {name}")
+                back = torch.load(out / "lite" / "checkpoint.pt")
+                self.assertNotIn("optimiser", back)   # slim: under the 16 MiB a returned file may have
+                self.assertIn("lr", back)
+                self.assertEqual(next(iter(back["model"].values())).dtype, torch.float16)
+                self.assertNotIn("ema", back)   # --ema 0.999: the average crosses as the weights
+                for name in ("last.pt", "best.pt", "train.log", "log.csv"):
+                    self.assertTrue((runs["inpaint"] / name).exists(), f"inpaint {name}")
+                back = torch.load(out / "inpaint" / "last.pt")
+                self.assertNotIn("opt_g", back)
+                self.assertEqual(next(iter(back["generator"].values())).dtype, torch.float32)
+            log = (runs["lite"] / "train.log").read_text()
+            self.assertIn("initialised lite from weights/depth_lite.ampw", log)
+            self.assertIn("(slim: Adam restarts)", log)
+            self.assertIn("weights averaged (decay 0.999)", log)
+            self.assertIn("cosine decay from 1.00e-03 to 1.00e-05 at step 1000", log)
+            self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
+            self.assertIn("ordinal_whdr", log)
+            self.check_inpaint_logs(runs["inpaint"])
+
+    def check_plane_map(self, carry: Path, disparity: Path):
+        """A carried plane map is what the inpainting data slices from the map at the
+        carried photo's size."""
+        with Image.open(carry / "inpaint_planes" / "set" / "p0.jpg.png") as image:
+            planes = np.asarray(image)
+        disparity_map = inpaint_data.load_disparity(str(disparity / "set" / "p0.jpg.png"), (384, 128))
+        sliced = inpaint_data.slice_labels(disparity_map)
+        np.testing.assert_array_equal(planes, sliced)
+        self.assertGreater(planes.max(), 0)
+
+    def check_inpaint_logs(self, run: Path):
+        log = (run / "train.log").read_text()
+        self.assertEqual(log.count("generator starts from weights/inpaint.ampw"), 1)
+        self.assertIn("(slim: Adam restarts)", log)
+        self.assertEqual(log.count("prepared 3 sliced photos from 3 (0 with the stand-in disparity)"), 2)
+        self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
+        rows = (run / "log.csv").read_text().splitlines()
+        self.assertTrue(rows[0].startswith("step,") and not any(r.startswith("step,") for r in rows[1:]))
+        steps = [int(row.split(",")[0]) for row in rows[1:]]
+        self.assertEqual(steps, sorted(set(steps)))   # the second run continued the first's steps
+        self.assertGreater(steps[-1], 2)
+
+    def test_pack_refuses_more_than_the_device_tool_carries(self):
+        with tempfile.TemporaryDirectory() as folder:
+            tmp = Path(folder)
+            make_photos(tmp)
+            with mock.patch.dict(os.environ, AMPI_PHOTO_ROOT=str(tmp / "photos")), \
+                    mock.patch.object(gpu_run, "TRANSFER_LIMIT", 2 ** 20), contextlib.redirect_stdout(io.StringIO()), \
+                    self.assertRaises(SystemExit) as refused:
+                gpu_run.main(["pack", "--run", f"inpaint:{tmp / 'inpaint'}", "--carry", str(tmp / "carry"),
+                              "--ordinal", str(tmp / "ordinal.json")])
+            message = str(refused.exception)
+            self.assertIn("more than the device tool's 1 MiB", message)
+            self.assertIn("photos 0.2", message)
+            self.assertNotIn("\n", message)
 
     def test_unpack_without_files_leaves_the_run_alone(self):
         with tempfile.TemporaryDirectory() as folder:
@@ -91,6 +163,44 @@ class RoundTrip(unittest.TestCase):
             self.assertNotEqual(result.returncode, 0)
             self.assertIn("did not come back", result.stderr)
             self.assertFalse(run.exists())
+
+
+class LearningRateDecay(unittest.TestCase):
+    def test_cosine_values(self):
+        args = argparse.Namespace(lr=1e-3, decay_steps=100)
+        for step, lr in ((0, 1e-3), (50, (1e-3 + 1e-5) / 2), (100, 1e-5), (250, 1e-5)):
+            self.assertAlmostEqual(train_depth.cosine_lr(args, step), lr, places=12)
+        self.assertAlmostEqual(train_depth.cosine_lr(args, 25), 1e-5 + 0.99e-3 * (0.5 + 0.5 ** 1.5), places=12)
+
+    def test_a_resumed_run_continues_the_curve(self):
+        """Steps 1-3, then steps 4-7 from the slim checkpoint with a stale learning rate in
+        it: every step trains at the curve's rate for its step."""
+        with tempfile.TemporaryDirectory() as folder:
+            tmp = Path(folder)
+            make_photos(tmp)
+            env = dict(os.environ, AMPI_PHOTO_ROOT=str(tmp / "photos"))
+            run = tmp / "run"
+            common = ["--model", "lite", "--run", str(run), "--data", "scenes", "--size", "64x64", "--batch", "1",
+                      "--lr-decay", "cosine", "--decay-steps", "5", "--workers", "0", "--log-every", "1",
+                      "--val-every", "100", "--val-count", "1", "--checkpoint-every", "100"]
+
+            def train(steps: int):
+                done = subprocess.run([PYTHON, str(HERE / "train_depth.py"), *common, "--steps", str(steps)],
+                                      cwd=ROOT, env=env, capture_output=True, text=True)
+                self.assertEqual(done.returncode, 0, done.stderr)
+
+            train(3)
+            subprocess.run([PYTHON, str(HERE / "gpu_run.py"), "slim", str(run / "checkpoint.pt"),
+                            str(run / "checkpoint.pt")], check=True)
+            slim = torch.load(run / "checkpoint.pt")
+            slim["lr"] = 0.5
+            torch.save(slim, run / "checkpoint.pt")
+            train(7)
+            log = (run / "train.log").read_text()
+            self.assertIn("(slim: Adam restarts)", log)
+            logged = {int(step): lr for step, lr in re.findall(r"^\S+ \S+ step (\d+) loss .* lr (\S+)", log, re.M)}
+            curve = argparse.Namespace(lr=1e-3, decay_steps=5)
+            self.assertEqual(logged, {step: f"{train_depth.cosine_lr(curve, step - 1):.2e}" for step in range(1, 8)})
 
 
 if __name__ == "__main__":

@@ -4,7 +4,9 @@
         --data scenes --size 256x192 --batch 4 --steps 20000
 
 The paper's recipe: Adam at 1e-3, learning rate x0.2 when the validation loss plateaus,
-the loss of training/losses.py on all four outputs. Runs are resumable: the run folder
+the loss of training/losses.py on all four outputs. `--lr-decay cosine --decay-steps N`
+replaces the plateau rule by a fixed curve: --lr down to --lr / 100 at step N by half a
+cosine, flat after (cosine_lr). Runs are resumable: the run folder
 holds `checkpoint.pt` (model, optimiser, scheduler, step, best validation loss), written
 atomically every --checkpoint-every steps, `best.pt` (the weights of the best validation
 loss so far: what to export), and `train.log`, one text line per logged step and per
@@ -260,6 +262,13 @@ def _worker_init(_):
     torch.set_num_threads(1)  # the network's threads are the main process's
 
 
+def batches_ahead(dataset, workers: int):
+    """A DataLoader over dataset's items, each a whole batch, made ahead by `workers`
+    processes of one thread each (0: in the loop). Shared with train_inpaint.py."""
+    ahead = {"num_workers": workers, "worker_init_fn": _worker_init, "prefetch_factor": 2} if workers else {}
+    return torch.utils.data.DataLoader(dataset, batch_size=None, shuffle=False, **ahead)
+
+
 # ---- metrics ------------------------------------------------------------------------------
 
 METRIC_NAMES = ("delta1.25", "delta1.25^2", "delta1.25^3", "rmse", "rel")
@@ -351,6 +360,27 @@ def initial_model(args, source, size, resuming: bool):
     rng = random.Random(args.seed)
     batches = [make_batch(source, VAL_SEED_START // 2 + i * 8, 8, False, rng)[0] for i in range(8)]
     return export_depth.unfold_batchnorm(model, batches).train()
+
+
+LR_FLOOR = 0.01  # the cosine decay ends at this share of --lr
+
+
+def cosine_lr(args, step: int) -> float:
+    """The learning rate of step (counted from the run's start) under --lr-decay cosine:
+    --lr at step 0, LR_FLOOR x --lr from --decay-steps on, half a cosine between. A function
+    of the step alone, so a resumed run continues the same curve whatever learning rate its
+    checkpoint holds (a slim one's is that of its last step)."""
+    floor = args.lr * LR_FLOOR
+    done = min(step, args.decay_steps) / args.decay_steps
+    return floor + (args.lr - floor) * 0.5 * (1.0 + math.cos(math.pi * done))
+
+
+def follow_schedule(optimiser, args, step: int):
+    """Under --lr-decay cosine, the learning rate step trains at; otherwise nothing (the
+    plateau rule moves it at validations)."""
+    if args.lr_decay == "cosine":
+        for group in optimiser.param_groups:
+            group["lr"] = cosine_lr(args, step)
 
 
 def training_step(model, optimiser, batch, args):
@@ -448,12 +478,15 @@ def train(args):
         log_line(run, f"resumed {args.model} at step {step} from {ckpt_path}{note}")
     elif args.init:
         log_line(run, f"initialised {args.model} from {args.init}")
+    follow_schedule(optimiser, args, step)
     val_count = source.validation_count(args.val_count)
     real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g})"
             if ordinal_train else "")
     ema = f", weights averaged (decay {args.ema:g})" if average else ""
+    decay = (f" (cosine decay from {args.lr:.2e} to {args.lr * LR_FLOOR:.2e} at step {args.decay_steps})"
+             if args.lr_decay == "cosine" else "")
     log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data}{real} "
-                  f"at {size[0]}x{size[1]}, batch {args.batch}, lr {optimiser.param_groups[0]['lr']:.2e}{ema}, "
+                  f"at {size[0]}x{size[1]}, batch {args.batch}, lr {optimiser.param_groups[0]['lr']:.2e}{decay}{ema}, "
                   f"{args.threads} threads, {args.workers} workers")
 
     def checkpoint():
@@ -468,7 +501,8 @@ def train(args):
     def validation():
         nonlocal best
         val_loss, metrics = validate(measured, val_batches, args.device)
-        scheduler.step(val_loss)
+        if args.lr_decay == "none":
+            scheduler.step(val_loss)
         whdr = validate_ordinal(measured, ordinal_val, max(size), args.device) if ordinal_val else None
         score = whdr if whdr is not None else val_loss
         if score < best:  # the weights worth exporting, kept apart from the latest
@@ -481,14 +515,13 @@ def train(args):
             shown += f" ordinal_whdr {whdr:.4f}"
         log_line(run, f"val step {step} loss {val_loss:.4f} {shown} best {best:.4f}")
 
-    ahead = {"num_workers": args.workers, "worker_init_fn": _worker_init, "prefetch_factor": 2} if args.workers else {}
-    batches = torch.utils.data.DataLoader(TrainingBatches(source, args, size, step, ordinal_train),
-                                          batch_size=None, shuffle=False, **ahead)
+    batches = batches_ahead(TrainingBatches(source, args, size, step, ordinal_train), args.workers)
     t0, seen, timed_from = time.time(), 0, None
     for rgb, disp, steps, real in batches:
         rgb = rgb.to(args.device, non_blocking=True)
         disp = disp.to(args.device, non_blocking=True)
         for step_of_batch, (real_rgb, pairs) in zip(steps, real):
+            follow_schedule(optimiser, args, step)
             loss, parts, rank = training_step(model, optimiser,
                                               (*scene_view(rgb, disp, step_of_batch, args), real_rgb, pairs), args)
             if average:
@@ -528,7 +561,12 @@ def main(argv=None):
     p.add_argument("--batch", type=int, default=4)
     p.add_argument("--steps", type=int, default=20000, help="total steps (a resumed run continues to this)")
     p.add_argument("--lr", type=float, default=1e-3)
-    p.add_argument("--patience", type=int, default=5, help="validations without improvement before lr x0.2")
+    p.add_argument("--patience", type=int, default=5,
+                   help="validations without improvement before lr x0.2 (with --lr-decay none)")
+    p.add_argument("--lr-decay", choices=("none", "cosine"), default="none",
+                   help="none: x0.2 on a plateau; cosine: --lr to --lr / 100 at --decay-steps, by the step")
+    p.add_argument("--decay-steps", type=int, default=0,
+                   help="the step (counted from the run's start) where --lr-decay cosine reaches its floor")
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--seed", type=int, default=1)
     p.add_argument("--log-every", type=int, default=10)
@@ -549,7 +587,10 @@ def main(argv=None):
     p.add_argument("--ema", type=float, default=0.0,
                    help="validate and keep an exponential moving average of the weights with this decay "
                         "(e.g. 0.999; 0: the weights as trained)")
-    return train(p.parse_args(argv))
+    args = p.parse_args(argv)
+    if args.lr_decay == "cosine" and args.decay_steps <= 0:
+        raise SystemExit("train_depth.py: --lr-decay cosine needs --decay-steps N (N > 0)")
+    return train(args)
 
 
 if __name__ == "__main__":

@@ -20,11 +20,17 @@ The discriminator minimises the hinge loss mean relu(1 - D(real)) + mean relu(1 
 Adam with lr 2e-4 (G) and 1e-4 (D) as in the paper; betas (0.5, 0.999), the usual choice
 for GAN training (the paper does not give them).
 
-Resumable: RUN_DIR/last.pt holds both networks, both optimisers, the step and the random
-states, written atomically every --checkpoint-every steps; RUN_DIR/best.pt the generator with
-the best validation PSNR. RUN_DIR/log.csv has one row per logged step.
+Resumable: RUN_DIR/last.pt holds both networks, both optimisers and the step, written
+atomically every --checkpoint-every steps and at the end; each step's batch is drawn from
+(--seed, step), so a resumed run draws what an uninterrupted one would have. RUN_DIR/best.pt
+holds the generator with the best validation PSNR, RUN_DIR/log.csv one row per logged step,
+RUN_DIR/train.log every line the run prints.
 
     nice -n 10 /usr/bin/python3 training/train_inpaint.py --run-dir training/runs/inpaint
+
+On a GPU machine (--device cuda), --workers processes make the batches ahead (slicing crops
+and their prefill is the work; the networks are small), and --minutes stops the run
+validated and checkpointed; training/gpu_run.py packs and launches such runs.
 """
 from __future__ import annotations
 
@@ -34,6 +40,7 @@ import math
 import os
 import sys
 import time
+from pathlib import Path
 
 import numpy as np
 import torch
@@ -45,6 +52,7 @@ import inpaint_data as data  # noqa: E402
 from inpaint_model import PREFILL, InpaintGenerator, PatchDiscriminator  # noqa: E402
 from losses import gradient_loss  # noqa: E402
 from export_inpaint import import_ampw as import_generator  # noqa: E402
+from train_depth import batches_ahead, log_line, save_checkpoint  # noqa: E402
 
 W_GRAD, W_DISC, W_PERC = 0.1, 0.01, 0.01
 LR_G, LR_D, BETAS = 2e-4, 1e-4, (0.5, 0.999)
@@ -69,7 +77,7 @@ class PerceptualFeatures(torch.nn.Module):
             net = export_depth.import_ampw(checkpoint)
             self.source = os.path.abspath(checkpoint)
         elif checkpoint:
-            state = torch.load(checkpoint, map_location="cpu")
+            state = torch.load(checkpoint, map_location="cpu", weights_only=False)
             net.load_state_dict(state.get("model", state))
             self.source = os.path.abspath(checkpoint)
         self.register_buffer("mean", net.mean.clone())
@@ -151,54 +159,71 @@ def fixed_validation(source: data.SampleSource, batch: int):
     return [source.batch(rng, batch) for _ in range(VALIDATION_SAMPLES // batch)]
 
 
-def save_atomic(obj, path):
-    tmp = path + ".tmp"
-    torch.save(obj, tmp)
-    os.replace(tmp, path)
-
-
 def validation_key(args):
     """What the fixed validation samples depend on besides the photos."""
     return {"crop": args.crop, "batch": args.batch, "seed": VALIDATION_SEED, "prefill": PREFILL,
             "standin_too": args.standin_too}
 
 
+class TrainingBatches(torch.utils.data.Dataset):
+    """The batch of every step from first_step to --steps, drawn with a generator seeded by
+    (--seed, step): DataLoader workers make them ahead and in parallel (--workers), and a
+    resumed run draws the batches an uninterrupted one would have."""
+
+    def __init__(self, source: data.SampleSource, args, first_step: int):
+        self.source, self.args, self.first_step = source, args, first_step
+
+    def __len__(self):
+        return max(0, self.args.steps - self.first_step)
+
+    def __getitem__(self, k):
+        return self.source.batch(np.random.default_rng([self.args.seed, self.first_step + k]), self.args.batch)
+
+
 def load_or_init(args, g, d, opt_g, opt_d, log):
+    """(step, best validation PSNR) of RUN_DIR/last.pt, its state loaded into the networks
+    and optimisers; (0, -inf) for a new run. A slim checkpoint (training/gpu_run.py) has no
+    Adam moments: they start again."""
     path = os.path.join(args.run_dir, "last.pt")
     if not os.path.exists(path):
-        return 0, -math.inf, np.random.default_rng(args.seed)
-    ck = torch.load(path, map_location="cpu")
+        return 0, -math.inf
+    ck = torch.load(path, map_location="cpu", weights_only=False)  # our own file, from any torch
     g.load_state_dict(ck["generator"])
     d.load_state_dict(ck["discriminator"])
-    opt_g.load_state_dict(ck["opt_g"])
-    opt_d.load_state_dict(ck["opt_d"])
+    if "opt_g" in ck:
+        opt_g.load_state_dict(ck["opt_g"])
+        opt_d.load_state_dict(ck["opt_d"])
     for opt, lr in ((opt_g, args.lr_g), (opt_d, args.lr_d)):  # the command line wins
         for group in opt.param_groups:
             group["lr"] = lr
     torch.set_rng_state(ck["torch_rng"])
-    rng = np.random.default_rng()
-    rng.bit_generator.state = ck["numpy_rng"]
-    log(f"resumed from {path} at step {ck['step']}")
+    log(f"resumed from {path} at step {ck['step']}" + ("" if "opt_g" in ck else " (slim: Adam restarts)"))
     best = ck["best_psnr"]
     if ck.get("validation") != validation_key(args):
         log("the validation samples changed (crop or batch): the best PSNR starts over")
         best = -math.inf
-    return ck["step"], best, rng
+    return ck["step"], best
 
 
-def checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi):
-    save_atomic({"step": step, "best_psnr": best, "generator": g.state_dict(), "residual": g.residual, "prefill": PREFILL,
-                 "discriminator": d.state_dict(), "opt_g": opt_g.state_dict(),
-                 "opt_d": opt_d.state_dict(), "torch_rng": torch.get_rng_state(),
-                 "numpy_rng": rng.bit_generator.state, "perceptual": phi.source,
-                 "validation": validation_key(args)},
-                os.path.join(args.run_dir, "last.pt"))
+def checkpoint(args, step, best, g, d, opt_g, opt_d, phi):
+    save_checkpoint(Path(args.run_dir) / "last.pt", {
+        "step": step, "best_psnr": best, "generator": g.state_dict(), "residual": g.residual, "prefill": PREFILL,
+        "discriminator": d.state_dict(), "opt_g": opt_g.state_dict(), "opt_d": opt_d.state_dict(),
+        "torch_rng": torch.get_rng_state(), "perceptual": phi.source, "validation": validation_key(args)})
+
+
+def save_best(args, step, psnr_db, g):
+    save_checkpoint(Path(args.run_dir) / "best.pt", {"step": step, "val_psnr": psnr_db, "generator": g.state_dict(),
+                                                     "residual": g.residual, "prefill": PREFILL})
 
 
 def parse_args(argv):
     ap = argparse.ArgumentParser(description="train the MPI inpainting generator")
     ap.add_argument("--photos", default=data.DEFAULT_PHOTOS)
     ap.add_argument("--disparity-dir", default=data.DEFAULT_DISPARITY_DIR)
+    ap.add_argument("--planes-dir", default=None,
+                    help="plane maps sliced ahead (inpaint_data.write_planes; what gpu_run.py carries): "
+                         "they replace the disparity of the photos they cover")
     ap.add_argument("--run-dir", default=os.path.join(os.path.dirname(__file__), "runs", "inpaint"))
     ap.add_argument("--perceptual", default=None,
                     help="depth network for L_perc: a train_depth.py checkpoint or an exported .ampw")
@@ -207,9 +232,13 @@ def parse_args(argv):
     ap.add_argument("--lr-g", type=float, default=LR_G, help="generator learning rate (paper: 2e-4)")
     ap.add_argument("--lr-d", type=float, default=LR_D, help="discriminator learning rate (paper: 1e-4)")
     ap.add_argument("--steps", type=int, default=1_000_000, help="stop after this many steps")
+    ap.add_argument("--minutes", type=float, default=0,
+                    help="stop after this many minutes of training, validated and checkpointed (0: run to --steps)")
     ap.add_argument("--batch", type=int, default=6)
     ap.add_argument("--crop", type=int, default=128)
+    ap.add_argument("--device", default="cpu", help="cpu, or cuda on a GPU machine")
     ap.add_argument("--threads", type=int, default=1)
+    ap.add_argument("--workers", type=int, default=0, help="processes making batches ahead (0: in the loop)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--log-every", type=int, default=25)
     ap.add_argument("--validate-every", type=int, default=250)
@@ -222,39 +251,47 @@ def parse_args(argv):
     return ap.parse_args(argv)
 
 
-def main(argv=None):
-    args = parse_args(argv)
-    torch.set_num_threads(args.threads)
-    os.makedirs(args.run_dir, exist_ok=True)
-
-    def log(msg):
-        print(f"[{time.strftime('%H:%M:%S')}] {msg}", flush=True)
-
-    train_rel, val_rel = data.split_photos(data.list_photos(args.photos))
-    if args.max_photos:
-        train_rel, val_rel = train_rel[:args.max_photos], val_rel[:max(1, args.max_photos // 10)]
-    prepare = lambda rels: data.prepare_photos(  # noqa: E731
-        args.photos, rels, args.disparity_dir, log, standin_too=args.standin_too)
-    train = data.SampleSource(prepare(train_rel), args.crop)
-    val_batches = fixed_validation(data.SampleSource(prepare(val_rel), args.crop), args.batch)
-
+def networks(args, log):
+    """The generator (new, or --init's for a new run), the discriminator and the perceptual
+    features, on --device."""
     torch.manual_seed(args.seed)
     g, d = InpaintGenerator(residual=not args.plain), PatchDiscriminator()
-    if args.init:
+    if args.init and not os.path.exists(os.path.join(args.run_dir, "last.pt")):
         g = import_generator(args.init)
         if g.residual == args.plain:
             raise SystemExit(f"{args.init}: its generator version does not match --plain")
         log(f"generator starts from {args.init}")
     phi = PerceptualFeatures(args.perceptual)
     log(f"perceptual features: depth encoder, {phi.source}")
+    return g.to(args.device), d.to(args.device), phi.to(args.device)
+
+
+def main(argv=None):
+    args = parse_args(argv)
+    torch.set_num_threads(args.threads)
+    os.makedirs(args.run_dir, exist_ok=True)
+
+    def log(msg):
+        log_line(Path(args.run_dir), msg)
+
+    train_rel, val_rel = data.split_photos(data.list_photos(args.photos))
+    if args.max_photos:
+        train_rel, val_rel = train_rel[:args.max_photos], val_rel[:max(1, args.max_photos // 10)]
+    prepare = lambda rels: data.prepare_photos(  # noqa: E731
+        args.photos, rels, args.disparity_dir, log, standin_too=args.standin_too, planes_dir=args.planes_dir)
+    train = data.SampleSource(prepare(train_rel), args.crop)
+    val_batches = [[t.to(args.device) for t in batch]
+                   for batch in fixed_validation(data.SampleSource(prepare(val_rel), args.crop), args.batch)]
+
+    g, d, phi = networks(args, log)
     opt_g = torch.optim.Adam(g.parameters(), lr=args.lr_g, betas=BETAS)
     opt_d = torch.optim.Adam(d.parameters(), lr=args.lr_d, betas=BETAS)
-    step, best, rng = load_or_init(args, g, d, opt_g, opt_d, log)
+    step, best = load_or_init(args, g, d, opt_g, opt_d, log)
     if step == 0:  # what training starts from (the prefill itself for an untrained residual net)
         best = validate(g, val_batches)[1]
-        save_atomic({"step": 0, "val_psnr": best, "generator": g.state_dict(), "residual": g.residual, "prefill": PREFILL},
-                    os.path.join(args.run_dir, "best.pt"))
+        save_best(args, 0, best, g)
         log(f"step 0: validation PSNR {best:.4f} (best.pt keeps it until a step beats it)")
+    log(f"train on {args.device}: batch {args.batch} of {args.crop} px crops, {args.workers} workers")
 
     log_path = os.path.join(args.run_dir, "log.csv")
     fields = ["step", "time", "loss_g", "data", "grad", "disc", "perc", "loss_d", "val_l1", "val_psnr"]
@@ -263,34 +300,37 @@ def main(argv=None):
         writer = csv.DictWriter(f, fieldnames=fields)
         if new_log:
             writer.writeheader()
-        running, started = {}, time.time()
-        while step < args.steps:
-            rgb, hole, removed, prefilled = train.batch(rng, args.batch)
+        running, summed, started = {}, 0, time.time()
+        for batch in batches_ahead(TrainingBatches(train, args, step), args.workers):
+            rgb, hole, removed, prefilled = (t.to(args.device, non_blocking=True) for t in batch)
             fake, parts = generator_step(g, d, phi, opt_g, rgb, hole, removed, prefilled)
             parts["loss_d"] = discriminator_step(d, opt_d, rgb, fake, removed)
             step += 1
             for k, v in parts.items():
                 running[k] = running.get(k, 0.0) + v
+            summed += 1  # fewer than --log-every after a resume
+            out_of_time = args.minutes > 0 and time.time() - started >= 60 * args.minutes
             row = None
             if step % args.log_every == 0:
-                row = {k: running[k] / args.log_every for k in running}
-                running = {}
-            if step % args.validate_every == 0:
+                row = {k: running[k] / summed for k in running}
+                running, summed = {}, 0
+            if step % args.validate_every == 0 or step == args.steps or out_of_time:
                 row = row or {}
                 row["val_l1"], row["val_psnr"] = validate(g, val_batches)
                 if row["val_psnr"] > best:
                     best = row["val_psnr"]
-                    save_atomic({"step": step, "val_psnr": best, "generator": g.state_dict(),
-                                 "residual": g.residual, "prefill": PREFILL},
-                                os.path.join(args.run_dir, "best.pt"))
+                    save_best(args, step, best, g)
             if row is not None:
                 row.update(step=step, time=round(time.time() - started, 1))
                 writer.writerow({k: (f"{v:.5f}" if isinstance(v, float) else v) for k, v in row.items()})
                 f.flush()
                 log(" ".join(f"{k}={v:.4f}" if isinstance(v, float) else f"{k}={v}" for k, v in row.items()))
             if step % args.checkpoint_every == 0:
-                checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi)
-    checkpoint(args, step, best, g, d, opt_g, opt_d, rng, phi)
+                checkpoint(args, step, best, g, d, opt_g, opt_d, phi)
+            if out_of_time:
+                log(f"stopped after {args.minutes:g} minutes at step {step}")
+                break
+    checkpoint(args, step, best, g, d, opt_g, opt_d, phi)
     return 0
 
 
