@@ -73,7 +73,7 @@ inline float gelu(float x) {
   const float t = std::min(std::fabs(x), erfc_poly::kMaxArg) - erfc_poly::kCentre;
   float q = erfc_poly::kQ[0];
   for (size_t i = 1; i < sizeof(erfc_poly::kQ) / sizeof(erfc_poly::kQ[0]); ++i) q = q * t + erfc_poly::kQ[i];
-  const float h = std::fabs(x) > erfc_poly::kZeroArg ? 0.0f : exp_polynomial(-0.5f * (x * x)) * q;
+  const float h = std::fabs(x) > erfc_poly::kZeroArg ? 0.0f : exp2_polynomial_nonpositive(erfc_poly::kMinusHalfLog2e * (x * x)) * q;
   return x * (x >= 0.0f ? 1.0f - h : h);
 }
 

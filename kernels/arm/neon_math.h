@@ -49,7 +49,7 @@ inline float32x4_t gelu(float32x4_t x) {
   using namespace erfc_poly;
   const float32x4_t ax = vabsq_f32(x);
   const float32x4_t t = vsubq_f32(vminq_f32(ax, vdupq_n_f32(kMaxArg)), vdupq_n_f32(kCentre));
-  const float32x4_t e = exp(vmulq_f32(vdupq_n_f32(-0.5f), vmulq_f32(x, x)));
+  const float32x4_t e = exp2_nonpositive(vmulq_f32(vdupq_n_f32(erfc_poly::kMinusHalfLog2e), vmulq_f32(x, x)));
   const uint32x4_t in_range = vcleq_f32(ax, vdupq_n_f32(kZeroArg));
   const float32x4_t h = vreinterpretq_f32_u32(vandq_u32(in_range, vreinterpretq_u32_f32(vmulq_f32(e, horner(kQ, t)))));
   const uint32x4_t nonnegative = vcgeq_f32(x, vdupq_n_f32(0.0f));

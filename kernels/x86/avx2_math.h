@@ -58,7 +58,7 @@ inline __m256 gelu(__m256 x) {
   const __m256 one = _mm256_set1_ps(1.0f);
   const __m256 ax = _mm256_andnot_ps(_mm256_set1_ps(-0.0f), x);
   const __m256 t = _mm256_sub_ps(_mm256_min_ps(ax, _mm256_set1_ps(kMaxArg)), _mm256_set1_ps(kCentre));
-  const __m256 e = exp(_mm256_mul_ps(_mm256_set1_ps(-0.5f), _mm256_mul_ps(x, x)));
+  const __m256 e = exp2_nonpositive(_mm256_mul_ps(_mm256_set1_ps(erfc_poly::kMinusHalfLog2e), _mm256_mul_ps(x, x)));
   __m256 h = _mm256_mul_ps(e, horner(kQ, t));
   h = _mm256_andnot_ps(_mm256_cmp_ps(ax, _mm256_set1_ps(kZeroArg), _CMP_GT_OQ), h);
   const __m256 nonnegative = _mm256_cmp_ps(x, _mm256_setzero_ps(), _CMP_GE_OQ);

@@ -63,7 +63,7 @@ inline __m512 gelu(__m512 x) {
   using namespace erfc_poly;
   const __m512 ax = _mm512_abs_ps(x);
   const __m512 t = _mm512_sub_ps(_mm512_min_ps(ax, _mm512_set1_ps(kMaxArg)), _mm512_set1_ps(kCentre));
-  const __m512 e = exp(_mm512_mul_ps(_mm512_set1_ps(-0.5f), _mm512_mul_ps(x, x)));
+  const __m512 e = exp2_nonpositive(_mm512_mul_ps(_mm512_set1_ps(erfc_poly::kMinusHalfLog2e), _mm512_mul_ps(x, x)));
   const __mmask16 in_range = _mm512_cmp_ps_mask(ax, _mm512_set1_ps(kZeroArg), _CMP_LE_OQ);
   const __m512 h = _mm512_maskz_mul_ps(in_range, e, horner(kQ, t));
   const __mmask16 nonnegative = _mm512_cmp_ps_mask(x, _mm512_setzero_ps(), _CMP_GE_OQ);
