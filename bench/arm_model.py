@@ -18,7 +18,9 @@ How:
    bound the loop reaches.
 4. The network estimate: every convolution of weights/depth_lite.ampw at 1024x768, its
    multiply-adds at the predicted speed of the kernel that runs it (GEMM for 1x1 and
-   full convolutions, depthwise for depthwise), on one core at the core's clock.
+   full convolutions, depthwise for depthwise), on one core at the core's clock; the
+   stem's 3x3 runs as Winograd's F(4x4, 3x3), its GEMM doing a quarter of the direct
+   multiply-adds.
 
 What it leaves out, so the figures are a model and not a measurement: memory (every load
 hits L1; on a Raspberry Pi 5 the depthwise layers are bound by DRAM bandwidth), the
@@ -159,7 +161,11 @@ def fma_per_cycle(cpu: str) -> float:
 
 def lite_layers(path: Path, height: int = 768, width: int = 1024):
     """(kind, multiply-adds) of every convolution of the lite network at height x width:
-    kind 'gemm' (1x1 and full convolutions) or 'depthwise', from the weight file's tensors."""
+    kind 'gemm' (1x1 and full convolutions) or 'depthwise', from the weight file's tensors.
+    A 3x3 convolution that Conv2d runs on its Winograd path (from 8 inputs, more than 4
+    outputs; every convolution of lite has stride 1) counts the GEMM's multiply-adds of
+    F(4x4, 3x3): 36 per 16 outputs where the direct sum takes 16 x 9 (its window and
+    output transforms are left out, as the epilogues are)."""
     meta, tensors = read_ampw(str(path))
     # enc{L}, dec{L}: level L works at 1/2^L of the input; head1 at level 1
     layers = []
@@ -173,7 +179,10 @@ def lite_layers(path: Path, height: int = 768, width: int = 1024):
         pixels = (height >> level) * (width >> level)
         out_c, kh, kw, in_c = t.shape
         kind = "depthwise" if ".dw." in name else "gemm"
-        layers.append((kind, pixels * out_c * kh * kw * in_c))
+        taps = kh * kw
+        if kind == "gemm" and (kh, kw) == (3, 3) and in_c >= 8 and out_c > 4:
+            taps = 36 / 16
+        layers.append((kind, pixels * out_c * taps * in_c))
     return layers
 
 
@@ -238,8 +247,9 @@ FMA rates in llvm-mca's models: {', '.join(f'{c} {r:.1f}' for c, r in rates.item
 
 ## Lite at 1024x768, one core
 
-{len(layers)} convolutions, {gmacs:.2f} G multiply-adds; each at its kernel's modelled share of the core's
-FMA bound (4 lanes x FMAs per cycle x clock). Clocks are those of the boards named.
+{len(layers)} convolutions, {gmacs:.2f} G multiply-adds (the Winograd stem's GEMM counted, not the direct
+sum it replaces); each at its kernel's modelled share of the core's FMA bound (4 lanes x
+FMAs per cycle x clock). Clocks are those of the boards named.
 
 {table(net_rows, ['core', 'found in', 'GHz', 'FMAs/cycle', 'GMAC/s peak', 'GEMM layers, ms', 'depthwise layers, ms', 'total, ms'])}
 """
