@@ -13,9 +13,15 @@ namespace ampi::neon {
 
 struct Vector {
   static float32x4_t load(const float* p) { return vld1q_f32(p); }
-  static void store(float* p, float32x4_t v) { vst1q_f32(p, v); }
+  // ST1, not the STR that vst1q_f32 becomes: llvm-mca's Cortex-A76 (Neoverse-N1) model
+  // gives a Q-form STR two vector-pipe micro-ops and ST1 one, and the vector pipes are
+  // the FMAs' (bench/RESULTS-arm-model.md). The "Q" operand tells GCC the 16 bytes
+  // written, so it still orders the loads and stores around it.
+  static void store(float* p, float32x4_t v) {
+    asm("st1 {%1.4s}, %0" : "=Q"(*reinterpret_cast<float(*)[4]>(p)) : "w"(v));
+  }
   // Plain stores: a 16-byte vector is a quarter of a line, too little to stream.
-  static void stream(float* p, float32x4_t v) { vst1q_f32(p, v); }
+  static void stream(float* p, float32x4_t v) { store(p, v); }
   static float32x4_t splat(float x) { return vdupq_n_f32(x); }
   // A load the compiler may not merge with an earlier one of the same address: each of a
   // block's accumulators starts from its own load of the bias, not from a copy of one
@@ -83,8 +89,10 @@ constexpr bool kStepColumns = true;
 // across blocks (depthwise_lanes.inl): 3x3's 9, beside a block's 8 accumulators and the
 // column being read, fit NEON's 32 registers; 5x5's 25 do not. bench/arm_model.py's 3x3 s1
 // loop went from 62 to 53 cycles on Neoverse-N1 (262 -> 154 instructions), and to 48 with
-// the bias loaded into each accumulator (Vector::load_again); the rest over the 40-cycle
-// FMA bound is the stores, whose data also goes through the two vector pipes.
+// the bias loaded into each accumulator (Vector::load_again), and to 44 against the
+// 40-cycle FMA bound with the stores as ST1 (Vector::store; 181 instructions: the
+// addresses now take integer adds, which the in-order Cortex-A55 model pays for, 142 ->
+// 159 cycles).
 constexpr int kDepthwiseWeightRegisters = 16;
 
 // v as a value GCC cannot look into: it may not fuse the multiply that made v with an add
