@@ -293,11 +293,12 @@ void self_attention(const float* qkv, int tokens, int dim, int heads, float scal
   // One task per head and block of queries; its products run on the calling thread (a
   // nested loop of the pool runs inline), so the split never depends on the thread count.
   pool.parallel_for(int64_t(heads) * query_blocks, 1, [&](int64_t u0, int64_t u1) {
-    std::vector<float> scores(size_t(kQueryBlock) * kKeyBlock);
+    AlignedBuffer scores_buffer = aligned_alloc64(size_t(kQueryBlock) * kKeyBlock * sizeof(float));
+    float* scores = static_cast<float*>(scores_buffer.get());
     for (int64_t u = u0; u < u1; ++u) {
       const int head = int(u / query_blocks), q0 = int(u % query_blocks) * kQueryBlock;
       attend(qkv + q0 * row + head * kv.head_dim, row, std::min(kQueryBlock, tokens - q0), kv, head, scale_base2,
-             out + q0 * out_stride + head * kv.head_dim, out_stride, scores.data(), pool, k);
+             out + q0 * out_stride + head * kv.head_dim, out_stride, scores, pool, k);
     }
   });
 }
