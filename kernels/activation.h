@@ -28,33 +28,17 @@ Activation parse_activation(const char* name);
 // time, and hardswish ends every GEMM tile and depthwise block of the depth network.
 constexpr float kOneSixth = 1.0f / 6.0f;
 
-// e^x by the vector exp's own steps (exp_polynomials.h): GELU's reference must evaluate
-// the formula the vector code does, so the two agree within a few ulp. The rounding and
-// the 2^n are done in float bits, as the vector code does them, rather than through
-// std::nearbyint and std::ldexp, library calls on the baseline x86-64 target.
-inline float exp_polynomial(float x) {
-  using namespace exp_poly;
-  x = std::min(std::max(x, kMin), kMax);
-  // Adding and subtracting 1.5 * 2^23 rounds to the nearest integer (ties to even) for
-  // |v| < 2^22; here |v| < 128.
-  constexpr float kRoundingShift = 12582912.0f;
-  const float n = (x * kLog2e + kRoundingShift) - kRoundingShift;
-  const float r = (x - n * kLn2Hi) - n * kLn2Lo;
-  float p = kExp[0];
-  for (size_t i = 1; i < sizeof(kExp) / sizeof(kExp[0]); ++i) p = p * r + kExp[i];
-  // 2^n for n in [-126, 127]: the exponent field alone.
-  const uint32_t bits = static_cast<uint32_t>(static_cast<int32_t>(n) + 127) << 23;
-  float two_to_n;
-  std::memcpy(&two_to_n, &bits, sizeof two_to_n);
-  return (p * (r * r) + (r + 1.0f)) * two_to_n;
-}
-
 // 2^y for y <= 0 (below kExp2Min it returns 2^kExp2Min) by the vector exp2_nonpositive's
-// own steps, as exp_polynomial mirrors exp: the softmax's reference.
+// own steps (exp_polynomials.h): the references of GELU and the softmax must evaluate the
+// formula the vector code does, so they agree within a few ulp. The rounding and the 2^n
+// are done in float bits, as the vector code does them, rather than through
+// std::nearbyint and std::ldexp, library calls on the baseline x86-64 target.
 inline float exp2_polynomial_nonpositive(float y) {
   using namespace exp_poly;
   y = std::max(y, kExp2Min);
-  constexpr float kRoundingShift = 12582912.0f;  // as above; |y| <= 126
+  // Adding and subtracting 1.5 * 2^23 rounds to the nearest integer (ties to even) for
+  // |v| < 2^22; here |y| <= 126.
+  constexpr float kRoundingShift = 12582912.0f;
   const float n = (y + kRoundingShift) - kRoundingShift;
   const float f = y - n;
   float p = kExp2[0];
@@ -73,7 +57,9 @@ inline float gelu(float x) {
   const float t = std::min(std::fabs(x), erfc_poly::kMaxArg) - erfc_poly::kCentre;
   float q = erfc_poly::kQ[0];
   for (size_t i = 1; i < sizeof(erfc_poly::kQ) / sizeof(erfc_poly::kQ[0]); ++i) q = q * t + erfc_poly::kQ[i];
-  const float h = std::fabs(x) > erfc_poly::kZeroArg ? 0.0f : exp2_polynomial_nonpositive(erfc_poly::kMinusHalfLog2e * (x * x)) * q;
+  const float h = std::fabs(x) > erfc_poly::kZeroArg
+                      ? 0.0f
+                      : exp2_polynomial_nonpositive(erfc_poly::kMinusHalfLog2e * (x * x)) * q;
   return x * (x >= 0.0f ? 1.0f - h : h);
 }
 
