@@ -484,16 +484,21 @@ FamilyWorkload gemm_workload() {
           }};
 }
 
+// A workload's make(): Conv2d on layer l, packed once per ISA, run over its map.
+std::function<FamilyCall()> conv_layer_call(const Layer& l) {
+  return [l] {
+    auto d = std::make_shared<LayerData>(l);
+    auto convs = per_isa<Conv2d>([&](const KernelTable& t) { return Conv2d(l.p, d->weights.data(), d->bias.data(), t); });
+    return FamilyCall([=](Isa isa, ThreadPool& pool) {
+      (*convs)[static_cast<int>(isa)].run(d->in.f32(), l.in_h, l.in_w, d->out.f32(), nullptr, pool);
+    });
+  };
+}
+
 FamilyWorkload depthwise_workload() {
   const Layer l = depthwise(kMapC, 3, 1, kMapH, kMapW);
   return {{"depthwise_row"}, "Conv2d, " + l.name + " over " + map_shape(kMapH, kMapW, kMapC),
-          4.0 * (2 * kMapPixels * kMapC + 10 * kMapC), [l] {
-            auto d = std::make_shared<LayerData>(l);
-            auto convs = per_isa<Conv2d>([&](const KernelTable& t) { return Conv2d(l.p, d->weights.data(), d->bias.data(), t); });
-            return FamilyCall([=](Isa isa, ThreadPool& pool) {
-              (*convs)[static_cast<int>(isa)].run(d->in.f32(), l.in_h, l.in_w, d->out.f32(), nullptr, pool);
-            });
-          }};
+          4.0 * (2 * kMapPixels * kMapC + 10 * kMapC), conv_layer_call(l)};
 }
 
 // The DPT head's 3x3 fusion convolution (Depth Anything V2 ViT-S at 518x518), whose
@@ -501,14 +506,9 @@ FamilyWorkload depthwise_workload() {
 FamilyWorkload winograd_workload() {
   const Layer l = general3x3(64, 64, 1, 148, 148);
   const double pixels = double(l.in_h) * l.in_w;
-  return {{"winograd_input", "winograd_output"}, "Conv2d (winograd path), " + l.name + " over " + map_shape(l.in_h, l.in_w, 64),
-          4.0 * pixels * (l.p.in_c + l.p.out_c), [l] {
-            auto d = std::make_shared<LayerData>(l);
-            auto convs = per_isa<Conv2d>([&](const KernelTable& t) { return Conv2d(l.p, d->weights.data(), d->bias.data(), t); });
-            return FamilyCall([=](Isa isa, ThreadPool& pool) {
-              (*convs)[static_cast<int>(isa)].run(d->in.f32(), l.in_h, l.in_w, d->out.f32(), nullptr, pool);
-            });
-          }};
+  return {{"winograd_input", "winograd_output"},
+          "Conv2d (winograd path), " + l.name + " over " + map_shape(l.in_h, l.in_w, l.p.in_c),
+          4.0 * pixels * (l.p.in_c + l.p.out_c), conv_layer_call(l)};
 }
 
 FamilyWorkload add_workload() {

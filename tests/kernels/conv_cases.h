@@ -69,6 +69,12 @@ inline Expected expected_output(const ConvCase& c, const ConvData& d) {
   return e;
 }
 
+// The path Conv2d takes for a case's layer.
+inline Conv2d::Path path_of(const ConvCase& c) {
+  const ConvData d(c);
+  return Conv2d(c.p, d.weights.data(), nullptr).path();
+}
+
 // Runs Conv2d into a GuardedOutput: a value never written or one written past the end fails.
 inline std::vector<float> run_conv(const ConvCase& c, const ConvData& d, const KernelTable& k,
                                    ThreadPool& pool) {

@@ -126,10 +126,6 @@ TEST_CASE("few-output conv (the taps path) matches the reference: channels, kern
 TEST_CASE("rows path (implicit GEMM) matches the reference: runs, strides, paddings, dilations") {
   ThreadPool pool(2);
   uint32_t seed = 9800;
-  const auto path_of = [](const ConvCase& c) {
-    const ConvData d(c);
-    return Conv2d(c.p, d.weights.data(), nullptr).path();
-  };
   // in_c around the 16-float run threshold and the vector widths; out_c past one panel.
   for (int in_c : sweep<int>({2, 5, 6, 8, 12, 16, 17, 33}, {5, 16}))
     for (int out_c : sweep<int>({5, 16, 17, 40}, {17}))

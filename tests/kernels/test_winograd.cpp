@@ -45,11 +45,6 @@ double gain(const double (&m)[kRows][kWindow]) {
 }
 constexpr float kUlps = 1e-6f;
 
-Conv2d::Path path_of(const ConvCase& c) {
-  const ConvData d(c);
-  return Conv2d(c.p, d.weights.data(), nullptr).path();
-}
-
 }  // namespace
 
 TEST_CASE("the F(4x4, 3x3) matrices give a 3-tap correlation exactly") {
