@@ -7,9 +7,9 @@
 // 256-bit stores, 1x1 16->64 at 512x384 4.95 -> 5.17 ms (cpu clock, 1 thread, medians
 // of alternating runs). Splitting the 6x8 tile's k over two accumulator sets (12 chains
 // instead of 6) measured no better on 1x1 96->24 (2.53 -> 2.52 ms).
-// As in the AVX-512 tile, the rows' pointers are set once per call and a product with no
-// activation and no residual (kPlain) skips the epilogue's dispatch: 96 x 1370 at k = 64
-// on 1 thread 128 -> 134 GFLOP/s.
+// As in the AVX-512 tile, the rows' pointers are set once per call and the activation
+// kind is a template argument (with_gemm_activation, conv_epilogue.h): 96 x 1370 at
+// k = 64 on 1 thread 128 -> 134 GFLOP/s.
 #include <algorithm>
 
 #include "kernels/conv_epilogue.h"
@@ -38,8 +38,9 @@ inline void store_columns(__m256 v, float* c, const float* residual, int columns
 }
 
 // Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel (a holds
-// the tile's row pointers); columns <= 8 * kVectors. kPlain: no activation and no residual.
-template <int kVectors, bool kPlain>
+// the tile's row pointers); columns <= 8 * kVectors. kAct: the activation kind
+// (conv_epilogue.h).
+template <int kVectors, int kAct>
 void panel_tile(const GemmArgs& g, const float* const (&a)[kGemmMr], const float* panel, int j0, int columns) {
   const int m = g.m, k = g.k;
   __m256 acc[kGemmMr][kVectors];
@@ -65,15 +66,15 @@ void panel_tile(const GemmArgs& g, const float* const (&a)[kGemmMr], const float
     if (r >= m) continue;
     __m256 out[kVectors];
     for (int v = 0; v < kVectors; ++v) out[v] = acc[r][v];
-    if constexpr (!kPlain) activate_tile(out, g.act, [](__m256 x, ActivationSpec a) { return activate(x, a); });
+    activate_tile_of<kAct>(out, g.act, [](__m256 x, ActivationSpec a) { return activate(x, a); });
     float* c = g.c + r * g.c_stride + j0;
-    const float* res = !kPlain && g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
+    const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
     for (int v = 0; v < kVectors; ++v)
       store_columns(out[v], c + 8 * v, res ? res + 8 * v : nullptr, columns - 8 * v);
   }
 }
 
-template <bool kPlain>
+template <int kAct>
 void panels(const GemmArgs& g) {
   const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
   // Rows past m re-read row m-1 (their results are dropped): no branches in the k loop.
@@ -83,9 +84,9 @@ void panels(const GemmArgs& g) {
   for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats) {
     const int columns = std::min(kGemmNr, g.n - j0);
     if (columns > 8)
-      panel_tile<2, kPlain>(g, a, panel, j0, columns);
+      panel_tile<2, kAct>(g, a, panel, j0, columns);
     else
-      panel_tile<1, kPlain>(g, a, panel, j0, columns);
+      panel_tile<1, kAct>(g, a, panel, j0, columns);
   }
 }
 
@@ -94,10 +95,7 @@ void panels(const GemmArgs& g) {
 void gemm(const GemmArgs& g) {
   // Into L2 (prefetcht1): the tile reads it only in the next call.
   for (int64_t i = 0; i < g.prefetch_floats; i += 16) __builtin_prefetch(g.prefetch_a + i, 0, 2);
-  if (g.act.kind == Activation::None && !g.residual)
-    panels<true>(g);
-  else
-    panels<false>(g);
+  with_gemm_activation(g.act.kind, [&](auto act) { panels<decltype(act)::value>(g); });
 }
 
 }  // namespace ampi::avx2

@@ -8,10 +8,11 @@
 // on 2. The next tile's A rows are prefetched while this one computes (GemmArgs::
 // prefetch_a), medians on 1 thread: 1x1 64->16 at 512x384 (50 MB in) 5.1 -> 3.1 ms,
 // 64->64 at 256x192 2.9 -> 2.3 ms, 128->128 at 128x96 2.2 -> 1.9 ms.
-// The rows' pointers are set once per call, and a product with no activation and no
-// residual (kPlain) stores its accumulators without the epilogue's dispatch, which made
-// GCC spill accumulators: short reductions gain most, 96 x 1370 on 1 thread (attention's
-// Q K^T shape) 243 -> 256 GFLOP/s at k = 64, 214 -> 241 at k = 32.
+// The rows' pointers are set once per call, and the activation kind is a template
+// argument for the kinds the networks use (with_gemm_activation, conv_epilogue.h): a
+// switch per row in the epilogue made GCC spill accumulators. Short reductions gain most:
+// 96 x 1370 on 1 thread (attention's Q K^T shape, no activation) 243 -> 256 GFLOP/s at
+// k = 64, 214 -> 241 at k = 32; ViT-S's fc1 with GELU 7.25 -> 6.97 ms.
 #include <algorithm>
 
 #include "kernels/conv_epilogue.h"
@@ -42,10 +43,11 @@ inline void stream_columns(__m512 v, float* c, const float* residual) {
 
 // Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel (a holds
 // the tile's row pointers): kFull 16-lane vectors, then (kHalf) one 8-lane vector for a
-// panel whose last columns fit in 8. kPlain: no activation and no residual. The half vector is a 256-bit FMA, which on cores that split 512-bit FMAs in two
-// (AMD Zen 4) costs half a full one, and on others no more. columns <= 16 * kFull + 8 *
-// kHalf, == 16 * kFull when kStream.
-template <int kFull, bool kHalf, bool kStream, bool kPlain>
+// panel whose last columns fit in 8. The half vector is a 256-bit FMA, which on cores
+// that split 512-bit FMAs in two (AMD Zen 4) costs half a full one, and on others no
+// more. columns <= 16 * kFull + 8 * kHalf, == 16 * kFull when kStream. kAct: the
+// activation kind (conv_epilogue.h).
+template <int kFull, bool kHalf, bool kStream, int kAct>
 void panel_tile(const GemmArgs& g, const float* const (&a)[kGemmMr], const float* panel, int j0, int columns) {
   static_assert(!(kHalf && kStream), "streamed outputs are whole 16-lane lines");
   constexpr int kVectors = kFull + (kHalf ? 1 : 0);
@@ -79,9 +81,9 @@ void panel_tile(const GemmArgs& g, const float* const (&a)[kGemmMr], const float
     __m512 out[kVectors];
     for (int v = 0; v < kFull; ++v) out[v] = acc[r][v];
     if constexpr (kHalf) out[kFull] = _mm512_zextps256_ps512(half[r]);
-    if constexpr (!kPlain) activate_tile(out, g.act, [](__m512 x, ActivationSpec a) { return activate(x, a); });
+    activate_tile_of<kAct>(out, g.act, [](__m512 x, ActivationSpec a) { return activate(x, a); });
     float* c = g.c + r * g.c_stride + j0;
-    const float* res = !kPlain && g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
+    const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
     for (int v = 0; v < kVectors; ++v) {
       if constexpr (kStream)
         stream_columns(out[v], c + 16 * v, res ? res + 16 * v : nullptr);
@@ -91,7 +93,7 @@ void panel_tile(const GemmArgs& g, const float* const (&a)[kGemmMr], const float
   }
 }
 
-template <bool kStream, bool kPlain>
+template <bool kStream, int kAct>
 void panels(const GemmArgs& g) {
   const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
   // Rows past m re-read row m-1 (their results are dropped): no branches in the k loop.
@@ -101,24 +103,21 @@ void panels(const GemmArgs& g) {
   for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats) {
     const int columns = std::min(kGemmNr, g.n - j0);
     if (columns > 24)
-      panel_tile<2, false, kStream, kPlain>(g, a, panel, j0, columns);
+      panel_tile<2, false, kStream, kAct>(g, a, panel, j0, columns);
     else if constexpr (kStream)  // whole lines: 16 columns
-      panel_tile<1, false, true, kPlain>(g, a, panel, j0, columns);
+      panel_tile<1, false, true, kAct>(g, a, panel, j0, columns);
     else if (columns > 16)
-      panel_tile<1, true, false, kPlain>(g, a, panel, j0, columns);
+      panel_tile<1, true, false, kAct>(g, a, panel, j0, columns);
     else if (columns > 8)
-      panel_tile<1, false, false, kPlain>(g, a, panel, j0, columns);
+      panel_tile<1, false, false, kAct>(g, a, panel, j0, columns);
     else
-      panel_tile<0, true, false, kPlain>(g, a, panel, j0, columns);
+      panel_tile<0, true, false, kAct>(g, a, panel, j0, columns);
   }
 }
 
 template <bool kStream>
 void panels(const GemmArgs& g) {
-  if (g.act.kind == Activation::None && !g.residual)
-    panels<kStream, true>(g);
-  else
-    panels<kStream, false>(g);
+  with_gemm_activation(g.act.kind, [&](auto act) { panels<kStream, decltype(act)::value>(g); });
 }
 
 }  // namespace
