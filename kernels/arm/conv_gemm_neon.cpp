@@ -44,7 +44,9 @@ inline void store_columns(float32x4_t v, float* c, const float* residual, int co
     AMPI_ROW_FMA(5, L) AMPI_ROW_FMA(6, L) AMPI_ROW_FMA(7, L)                                       \
   }
 
-// Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel.
+// Rows [0, m) x columns [j0, j0 + columns) of the output from one packed panel. kAct:
+// the activation kind, fixed at compile time as on x86 (conv_epilogue.h).
+template <int kAct>
 void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
   const int m = g.m, k = g.k;
   // Rows past m re-read row m-1 (their results are dropped): no branches in the k loop.
@@ -73,7 +75,7 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
   float32x4_t tile[kGemmMr][2] = {{c0_0, c0_1}, {c1_0, c1_1}, {c2_0, c2_1}, {c3_0, c3_1},
                                   {c4_0, c4_1}, {c5_0, c5_1}, {c6_0, c6_1}, {c7_0, c7_1}};
   for (int r = 0; r < std::min(m, kGemmMr); ++r) {
-    activate_tile(tile[r], g.act, [](float32x4_t x, ActivationSpec a) { return activate(x, a); });
+    activate_tile_of<kAct>(tile[r], g.act, [](float32x4_t x, ActivationSpec a) { return activate(x, a); });
     float* c = g.c + r * g.c_stride + j0;
     const float* res = g.residual ? g.residual + r * g.c_stride + j0 : nullptr;
     for (int v = 0; v < 2; ++v) store_columns(tile[r][v], c + 4 * v, res ? res + 4 * v : nullptr, columns - 4 * v);
@@ -92,9 +94,11 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
 
 void gemm(const GemmArgs& g) {
   const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
-  const float* panel = g.packed;
-  for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats)
-    panel_tile(g, panel, j0, std::min(kGemmNr, g.n - j0));
+  with_gemm_activation(g.act.kind, [&](auto act) {
+    const float* panel = g.packed;
+    for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats)
+      panel_tile<decltype(act)::value>(g, panel, j0, std::min(kGemmNr, g.n - j0));
+  });
 }
 
 }  // namespace ampi::neon
