@@ -32,17 +32,19 @@ inline void activate_tile(Vec (&v)[N], ActivationSpec act, Activate activate) {
   }
 }
 
-// A GEMM tile's activation kind as a template argument: one of the kinds below, or
+// An epilogue's activation kind as a template argument: one of the kinds below, or
 // kActivationAtRunTime (read from the arguments, by activate_tile).
 constexpr int kActivationAtRunTime = -1;
 
 // f(std::integral_constant<int, kind>) with the kind fixed at compile time for those the
-// networks' GEMMs use (None, ReLU, HardSwish, GELU) and kActivationAtRunTime for the
-// others. A tile compiled for one kind keeps its accumulators in registers through the
-// epilogue; with the dispatch per row (activate_tile) GCC spilled them (AVX-512, 1x1
-// 16->64 hard-swish at 512x384: 4.8 -> 2.3 ms on 1 thread).
+// networks' GEMMs and Winograd convolutions use (None, ReLU, HardSwish, GELU) and
+// kActivationAtRunTime for the others. A GEMM tile compiled for one kind keeps its
+// accumulators in registers through the epilogue; with the dispatch per row
+// (activate_tile) GCC spilled them (AVX-512, 1x1 16->64 hard-swish at 512x384: 4.8 ->
+// 2.3 ms on 1 thread). Winograd's output transform gains about 4% (3x3 64->64 at
+// 148x148).
 template <class F>
-void with_gemm_activation(Activation kind, F&& f) {
+void with_fixed_activation(Activation kind, F&& f) {
   const auto fixed = [&](auto k) { return f(std::integral_constant<int, static_cast<int>(decltype(k)::value)>{}); };
   switch (kind) {
     case Activation::None: return fixed(std::integral_constant<Activation, Activation::None>{});
@@ -51,6 +53,15 @@ void with_gemm_activation(Activation kind, F&& f) {
     case Activation::GELU: return fixed(std::integral_constant<Activation, Activation::GELU>{});
     default: return f(std::integral_constant<int, kActivationAtRunTime>{});
   }
+}
+
+// activate(v, act) with the kind fixed at compile time unless kKind is kActivationAtRunTime.
+template <int kKind, typename Vec, typename Activate>
+inline Vec activate_of(Vec v, ActivationSpec act, Activate activate) {
+  if constexpr (kKind == kActivationAtRunTime)
+    return activate(v, act);
+  else
+    return activate(v, ActivationSpec{static_cast<Activation>(kKind), act.alpha});
 }
 
 // activate_tile with the kind fixed at compile time unless kKind is kActivationAtRunTime.

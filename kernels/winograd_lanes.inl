@@ -1,8 +1,9 @@
 // Winograd F(4x4, 3x3) window and output transforms (kernels/winograd.h), written once
 // for AVX2, AVX-512 and NEON over the lane-generic channel helpers. Each ISA's
 // winograd_*.cpp includes this inside its own namespace, after its *_channels.h
-// (Channels, lane accessors, plus, minus, fmadd) and *_math.h (activate). Not a header:
-// no include guard.
+// (Channels, lane accessors, plus, minus, fmadd), *_math.h (activate) and
+// kernels/conv_epilogue.h (the activation fixed at compile time). Not a header: no
+// include guard.
 //
 // Channels are independent, so each channel vector goes through the 6x6 window as the
 // reference does, one axis then the other, with the matrices' structure written out:
@@ -55,8 +56,10 @@ void winograd_input(const float* in, int64_t row_stride, int c, float* v, int64_
   });
 }
 
-void winograd_output(const WinogradOutputArgs& o) {
-  const WinogradOutputArgs a = o;  // locals: the vector stores may alias anything
+namespace winograd_lanes {
+
+template <int kAct>
+void output(const WinogradOutputArgs& a) {
   Channels(a.channels).each([&](int j, auto lane) {
     using V = decltype(lane.load(a.m));
     V rows[4][6];  // A^T M: output row y, position column k
@@ -72,10 +75,17 @@ void winograd_output(const WinogradOutputArgs& o) {
       winograd_lanes::output_axis(lane, rows[y], out);
       for (int x = 0; x < a.cols; ++x) {
         const int64_t at = y * a.row_stride + static_cast<int64_t>(x) * a.channels + j;
-        V value = activate(plus(out[x], bias), a.act);
+        V value = activate_of<kAct>(plus(out[x], bias), a.act, [](V v, ActivationSpec s) { return activate(v, s); });
         if (a.residual) value = plus(value, lane.load(a.residual + at));
         lane.store(a.out + at, value);
       }
     }
   });
+}
+
+}  // namespace winograd_lanes
+
+void winograd_output(const WinogradOutputArgs& o) {
+  const WinogradOutputArgs a = o;  // locals: the vector stores may alias anything
+  with_fixed_activation(a.act.kind, [&](auto act) { winograd_lanes::output<decltype(act)::value>(a); });
 }

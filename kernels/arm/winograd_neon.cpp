@@ -1,4 +1,5 @@
 // NEON Winograd F(4x4, 3x3) transforms: the lane-generic kernels/winograd_lanes.inl.
+#include "kernels/conv_epilogue.h"
 #include "kernels/arm/neon_channels.h"
 #include "kernels/arm/neon_kernels.h"
 #include "kernels/arm/neon_math.h"

@@ -8,7 +8,7 @@
 // of alternating runs). Splitting the 6x8 tile's k over two accumulator sets (12 chains
 // instead of 6) measured no better on 1x1 96->24 (2.53 -> 2.52 ms).
 // As in the AVX-512 tile, the rows' pointers are set once per call and the activation
-// kind is a template argument (with_gemm_activation, conv_epilogue.h): 96 x 1370 at
+// kind is a template argument (with_fixed_activation, conv_epilogue.h): 96 x 1370 at
 // k = 64 on 1 thread 128 -> 134 GFLOP/s.
 #include <algorithm>
 
@@ -95,7 +95,7 @@ void panels(const GemmArgs& g) {
 void gemm(const GemmArgs& g) {
   // Into L2 (prefetcht1): the tile reads it only in the next call.
   for (int64_t i = 0; i < g.prefetch_floats; i += 16) __builtin_prefetch(g.prefetch_a + i, 0, 2);
-  with_gemm_activation(g.act.kind, [&](auto act) { panels<decltype(act)::value>(g); });
+  with_fixed_activation(g.act.kind, [&](auto act) { panels<decltype(act)::value>(g); });
 }
 
 }  // namespace ampi::avx2

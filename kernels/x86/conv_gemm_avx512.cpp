@@ -9,7 +9,7 @@
 // prefetch_a), medians on 1 thread: 1x1 64->16 at 512x384 (50 MB in) 5.1 -> 3.1 ms,
 // 64->64 at 256x192 2.9 -> 2.3 ms, 128->128 at 128x96 2.2 -> 1.9 ms.
 // The rows' pointers are set once per call, and the activation kind is a template
-// argument for the kinds the networks use (with_gemm_activation, conv_epilogue.h): a
+// argument for the kinds the networks use (with_fixed_activation, conv_epilogue.h): a
 // switch per row in the epilogue made GCC spill accumulators. Short reductions gain most:
 // 96 x 1370 on 1 thread (attention's Q K^T shape, no activation) 243 -> 256 GFLOP/s at
 // k = 64, 214 -> 241 at k = 32; ViT-S's fc1 with GELU 7.25 -> 6.97 ms.
@@ -117,7 +117,7 @@ void panels(const GemmArgs& g) {
 
 template <bool kStream>
 void panels(const GemmArgs& g) {
-  with_gemm_activation(g.act.kind, [&](auto act) { panels<kStream, decltype(act)::value>(g); });
+  with_fixed_activation(g.act.kind, [&](auto act) { panels<kStream, decltype(act)::value>(g); });
 }
 
 }  // namespace

@@ -1,4 +1,5 @@
 // AVX-512 Winograd F(4x4, 3x3) transforms: the lane-generic kernels/winograd_lanes.inl.
+#include "kernels/conv_epilogue.h"
 #include "kernels/x86/avx512_channels.h"
 #include "kernels/x86/avx512_kernels.h"
 #include "kernels/x86/avx512_math.h"
