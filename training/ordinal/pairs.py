@@ -10,7 +10,7 @@ Pairs come from a fixed seed and each photo's own name, so `sample` always makes
 file. Per photo and round: RANDOM_PAIRS pairs of points uniform over the photo, and
 EDGE_PAIRS pairs straddling a strong image edge (the two points on either side of it, along
 the gradient), so the set also asks about object boundaries. Rounds were labelled one after
-another (round 1: pairs 1-7, round 2: pairs 8-14); a new round adds pairs and leaves the
+another (round 1: pairs 1-7, round 2: pairs 8-14, round 3: pairs 15-21); a new round adds pairs and leaves the
 earlier ones, and their labels, as they were. Nothing here looks at any network's output:
 the labels are what a person (or labelling agent) sees in the marked image
 (INSTRUCTIONS.md). Coordinates are pixels of the photo upright (turned by its EXIF orientation, as
@@ -44,7 +44,7 @@ EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the
 EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
 ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
-ROUNDS = 2
+ROUNDS = 3
 PAIRS_PER_ROUND = RANDOM_PAIRS + EDGE_PAIRS
 LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
 PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
