@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <memory>
 #include <optional>
+#include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -153,7 +154,7 @@ int eval_inpaint(int argc, char** argv) {
 const char kDepthUsage[] =
     "usage: ampi eval depth --images DIR --reference DIR [--model NAME | --weights FILE]\n"
     "                       [--reference-is-distance] [--working-size N] [--limit N] [--threads N]\n"
-    "       ampi eval depth --images DIR --ordinal FILE [--split val|train|all] [...]\n"
+    "       ampi eval depth --images DIR --ordinal FILE [--split val|test|train|all] [...]\n"
     "\n"
     "The paper's depth metrics (delta < 1.25, 1.25^2, 1.25^3, RMSE, REL; Luvizon et al.,\n"
     "after Eigen et al. 2014) of the depth network on every photo under DIR (.jpg, .jpeg,\n"
@@ -184,7 +185,9 @@ const char kDepthUsage[] =
     "  --reference DIR           reference depth maps, same relative paths and names\n"
     "  --reference-is-distance   the references hold distances (larger = farther); 0 = none\n"
     "  --ordinal FILE            an ordinal set instead of reference maps (WHDR)\n"
-    "  --split S                 the ordinal set's photos scored: val (default), train or all\n"
+    "  --split S                 the ordinal set's part scored: val (default), test (the\n"
+    "                            validation photos' held-out pairs, never used to pick a\n"
+    "                            network), train or all\n"
     "  --model M                 a bundled depth model by name: lite (default), heavy\n"
     "  --weights FILE            a depth weight file instead\n"
     "  --working-size N          the network's working size (default: the weight file's): the\n"
@@ -243,7 +246,9 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
     std::fprintf(stderr, "%s: %d pairs, WHDR %.4f\n", e.photo.c_str(), s.pairs, s.whdr());
   }
   std::printf("%-20s %8s %7s %7s\n", "method", "WHDR", "pairs", "photos");
-  const int photos = int(set.size());
+  std::set<std::string> names;  // a validation photo has a val and a test entry
+  for (const OrdinalPhoto& e : set) names.insert(e.photo);
+  const int photos = int(names.size());
   print_ordinal_row(a.weights.empty() ? a.model : fs::path(a.weights).filename().string(), network, photos);
   print_ordinal_row("vertical-gradient", gradient, photos);
   print_ordinal_row("constant", constant, photos);
@@ -260,7 +265,8 @@ int eval_depth(int argc, char** argv) {
   p.flag("--reference-is-distance", &a.reference_is_distance);
   p.option("--ordinal", &a.ordinal);
   p.option("--split", [&](const std::string& v) {
-    if (v != "val" && v != "train" && v != "all") throw std::runtime_error("--split: '" + v + "' is not val, train or all");
+    if (v != "val" && v != "test" && v != "train" && v != "all")
+      throw std::runtime_error("--split: '" + v + "' is not val, test, train or all");
     a.split = v;
   });
   p.option("--model", [&](const std::string& v) {

@@ -114,7 +114,7 @@ def ordinal_table(ampi, threads):
     import photo_folder
     root = photo_folder.photo_root()
     runs = []
-    for split in ('val', 'train'):
+    for split in ('val', 'test', 'train'):
         for model in ('lite', 'heavy'):
             command = [ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(ORDINAL_SET),
                        '--split', split, '--model', model, '--threads', str(threads)]
@@ -128,26 +128,29 @@ def ordinal_table(ampi, threads):
         'photos of `../shared/data/photos`, PHOTOS below). WHDR is the share of pairs labelled A or',
         'B nearer whose order the disparity gets wrong, a tie counting half; lower is better.',
         '`vertical-gradient` (lower = nearer) and `constant` are the guesses a network must beat.',
-        'The validation photos (every fifth of each folder) are never trained on; the training',
-        "photos' pairs are in the ranking loss, so their row only shows how well it is fitted.",
+        'The validation photos (every fifth of each folder) are never trained on: their pairs of',
+        'rounds 1 and 2 (`val`) pick the best of a training run, those of round 3 (`test`) never',
+        "pick anything. The training photos' pairs are in the ranking loss, so their row only",
+        'shows how well it is fitted.',
         '',
         '| split | method | WHDR | pairs | photos |',
         '|---|---|---:|---:|---:|',
     ]
-    for split in ('val', 'train'):
+    for split in ('val', 'test', 'train'):
         split_runs = [r for r in runs if r[0] == split]
         rows = {m: ordinal_rows(out)[m] for _, m, _, out, _ in split_runs}
         guesses = ordinal_rows(split_runs[0][3])
         rows.update({g: guesses[g] for g in ('vertical-gradient', 'constant')})
         lines += [f'| {split} | {m} | {w:.4f} | {n} | {p} |' for m, (w, n, p) in rows.items()]
-    val = {m: ordinal_rows(out) for s, m, _, out, _ in runs if s == 'val'}
-    gradient = val['lite']['vertical-gradient'][0]
-    for model in ('lite', 'heavy'):
-        whdr = val[model][model][0]
-        gain = 100 * (gradient - whdr)
-        side = 'below (better than)' if gain > 0 else 'above (worse than)'
-        lines.append(f'\n{model} on the validation photos: WHDR {whdr:.4f}, {abs(gain):.1f} points {side} the '
-                     f'vertical gradient\'s {gradient:.4f} (the target for lite: at least 10 below).')
+    for split, what in (('val', 'validation pairs'), ('test', 'held-out test pairs')):
+        scored = {m: ordinal_rows(out) for s, m, _, out, _ in runs if s == split}
+        gradient = scored['lite']['vertical-gradient'][0]
+        for model in ('lite', 'heavy'):
+            whdr = scored[model][model][0]
+            gain = 100 * (gradient - whdr)
+            side = 'below (better than)' if gain > 0 else 'above (worse than)'
+            lines.append(f'\n{model} on the {what}: WHDR {whdr:.4f}, {abs(gain):.1f} points {side} the '
+                         f'vertical gradient\'s {gradient:.4f} (the target for lite: at least 10 below).')
     lines += ['', 'The outputs these rows are copied from:', '']
     for split, model, command, out, seconds in runs:
         lines += [f'## {model}, {split}', '', f'`{command}` ({seconds:.0f} s)', '', '```', out.rstrip(), '```', '']

@@ -22,7 +22,7 @@ struct OrdinalPair {
 struct OrdinalPhoto {
   std::string photo;   // path relative to the photo folder, e.g. "sun80/x.jpg"
   cv::Size size;       // the photo's size when it was labelled
-  std::string split;   // "train" or "val"
+  std::string split;   // "train", "val" or "test" (a validation photo's held-out pairs)
   std::vector<OrdinalPair> pairs;
 };
 

@@ -31,14 +31,15 @@ class OrdinalPhoto:
 
 
 def validation_photos(photo_root: Path, ordinal_file: Path = ORDINAL_FILE) -> set:
-    """Resolved paths of every photo of the validation split, labelled pairs or not: no
-    other training data may show them (train_depth.py's distilled source leaves them out)."""
+    """Resolved paths of every photo of the validation split (its test part included),
+    labelled pairs or not: no other training data may show them (train_depth.py's
+    distilled source leaves them out)."""
     entries = json.loads(Path(ordinal_file).read_text())["photos"]
-    return {(Path(photo_root) / e["photo"]).resolve() for e in entries if e["split"] == "val"}
+    return {(Path(photo_root) / e["photo"]).resolve() for e in entries if e["split"] in ("val", "test")}
 
 
 def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE):
-    """The photos of one split ('train' or 'val') with their ordered pairs."""
+    """The photos of one split ('train', 'val' or 'test') with their ordered pairs."""
     entries = json.loads(Path(ordinal_file).read_text())["photos"]
     photos = []
     for entry in entries:

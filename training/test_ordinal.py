@@ -104,6 +104,16 @@ class Labelling(unittest.TestCase):
             for x, y in (pair["a"], pair["b"]):
                 self.assertTrue(0 <= x < 300 and 0 <= y < 200, pair)
 
+    def test_the_test_rounds_of_a_validation_photo_are_an_entry_of_their_own(self):
+        def pair(i):
+            return {"id": i, "label": "A"}
+        first, test_round = [pair(1), pair(8)], [pair(7 * (r - 1) + 2) for r in pairs.TEST_ROUNDS]
+        self.assertEqual(pairs.split_parts("val", first + test_round), [("val", first), ("test", test_round)])
+        self.assertEqual(pairs.split_parts("val", first), [("val", first)])
+        self.assertEqual(pairs.split_parts("val", test_round), [("test", test_round)])
+        self.assertEqual(pairs.split_parts("train", first + test_round), [("train", first + test_round)])
+        self.assertEqual(pairs.split_parts("train", []), [])
+
     def test_an_order_is_kept_only_when_every_labeller_gave_it(self):
         self.assertEqual(pairs.consensus(["A"]), "A")
         self.assertEqual(pairs.consensus(["B", "B"]), "B")

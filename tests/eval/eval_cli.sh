@@ -99,7 +99,10 @@ else
 fi
 expect_error "ordinal, empty split" "no photos in split train" \
   depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split train
-expect_error "ordinal, bad split" "--split: 'test'" depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split test
+expect_error "ordinal, empty test split" "no photos in split test" \
+  depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split test
+expect_error "ordinal, bad split" "--split: 'held-out'" \
+  depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split held-out
 expect_error "ordinal and reference" "give one of them" \
   depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --reference "$tmp/ref"
 expect_error "ordinal, missing photo" "$tmp/small/images/sub/a.jpg: photo of the ordinal set not found" \

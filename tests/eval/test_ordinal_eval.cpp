@@ -89,8 +89,8 @@ TEST_CASE("a malformed ordinal set gets one error naming the file and the proble
   CHECK(error_of(path) == path + ": sub/a.jpg: 'b' is not a point [x, y]");
   path = broken(R"("a": [5.0, 25.0])", R"("a": [5.0, 30.0])");
   CHECK(error_of(path) == path + ": sub/a.jpg: a point lies outside the photo");
-  path = broken(R"("split": "val")", R"("split": "test")");
-  CHECK(error_of(path) == path + ": sub/a.jpg: split 'test' is not train or val");
+  path = broken(R"("split": "val")", R"("split": "held-out")");
+  CHECK(error_of(path) == path + ": sub/a.jpg: split 'held-out' is not train, val or test");
   path = broken(R"("width": 40)", R"("width": 0)");
   CHECK(error_of(path) == path + ": sub/a.jpg: width and height must be positive integers");
   path = dir.write("empty.json", R"({"photos": []})");

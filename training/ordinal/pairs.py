@@ -10,8 +10,9 @@ Pairs come from a fixed seed and each photo's own name, so `sample` always makes
 file. Per photo and round: RANDOM_PAIRS pairs of points uniform over the photo, and
 EDGE_PAIRS pairs straddling a strong image edge (the two points on either side of it, along
 the gradient), so the set also asks about object boundaries. Rounds were labelled one after
-another (round 1: pairs 1-7, round 2: pairs 8-14, round 3: pairs 15-21); a new round adds pairs and leaves the
-earlier ones, and their labels, as they were. Nothing here looks at any network's output:
+another (round 1: pairs 1-7, round 2: pairs 8-14, round 3: pairs 15-21); a new round adds
+pairs and leaves the earlier ones, and their labels, as they were. The validation photos'
+pairs of TEST_ROUNDS are merged as a part of their own, split 'test'. Nothing here looks at any network's output:
 the labels are what a person (or labelling agent) sees in the marked image
 (INSTRUCTIONS.md). Coordinates are pixels of the photo upright (turned by its EXIF orientation, as
 `ampi` reads it; x right, y down).
@@ -45,6 +46,10 @@ EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
 ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
 ROUNDS = 3
+# The validation photos' pairs of these rounds are the test part (split 'test'): no
+# network is ever selected on them. Rounds 1 and 2 of the validation photos had picked
+# the bundled networks, and on the fresh round 3 lite scored far worse than on them.
+TEST_ROUNDS = (3,)
 PAIRS_PER_ROUND = RANDOM_PAIRS + EDGE_PAIRS
 LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
 PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
@@ -241,6 +246,16 @@ def agreement(labels):
     return len(multi), same, opposite
 
 
+def split_parts(split, pairs):
+    """(split, pairs) entries of one photo: a validation photo's pairs of TEST_ROUNDS go
+    to an entry of their own, split 'test'; empty parts are left out."""
+    if split != 'val':
+        return [(split, pairs)] if pairs else []
+    test = [p for p in pairs if round_of(p['id']) in TEST_ROUNDS]
+    val = [p for p in pairs if round_of(p['id']) not in TEST_ROUNDS]
+    return [(s, part) for s, part in (('val', val), ('test', test)) if part]
+
+
 def cmd_merge(args):
     labels = read_labels(LABELS_DIR)
     photos = json.loads(PAIRS_FILE.read_text())['photos']
@@ -253,13 +268,13 @@ def cmd_merge(args):
         pairs = [dict(p, label=consensus(labels[(entry['photo'], p['id'])]),
                       votes=''.join(labels[(entry['photo'], p['id'])]))
                  for p in entry['pairs'] if (entry['photo'], p['id']) in labels]
-        if pairs:
-            merged.append({k: entry[k] for k in ('photo', 'width', 'height', 'split')} | {'pairs': pairs})
+        for split, part in split_parts(entry['split'], pairs):
+            merged.append({k: entry[k] for k in ('photo', 'width', 'height')} | {'split': split, 'pairs': part})
     ORDINAL_FILE.write_text(json.dumps({
         'seed': SEED, 'labels': 'A: a nearer, B: b nearer, =: too close to call',
         'votes': "every labeller's label; an order is kept only when all of them gave it",
         'photos': merged}, indent=1) + '\n')
-    for split in ('train', 'val'):
+    for split in ('train', 'val', 'test'):
         chosen = [p for e in merged if e['split'] == split for p in e['pairs']]
         ordered = sum(p['label'] != '=' for p in chosen)
         n_photos = sum(e['split'] == split for e in merged)
