@@ -147,6 +147,15 @@ class Texturing(unittest.TestCase):
             np.testing.assert_allclose(got[:, i], value ** 2, atol=1e-4,
                                        err_msg=f'seed {seed}, sample {i} at ({x[i]}, {y[i]})')
 
+    def test_samples_past_the_last_texel_read_the_edge(self):
+        # A crop scaled to a coarse level: 2.5 + 5.5 ends past the 7-texel-wide level, and
+        # the mirrored repeat takes x = 4.5 to texel 7.0, one past the last.
+        image = np.arange(3 * 4 * 7, dtype=np.uint8).reshape(3, 4, 7)
+        x = np.full(5, 4.5, np.float32)
+        got = textures.sample_bilinear(torch.from_numpy(image), (2.5, 0.0, 5.5, 4.0), x, np.zeros(5, np.float32))
+        edge = (image[:, 0, 6].astype(np.float64) / 255) ** 2
+        np.testing.assert_allclose(got, np.repeat(edge[:, None], 5, axis=1), atol=1e-6)
+
     def test_mip_levels_average_two_by_two_blocks(self):
         seed = 3
         image = np.random.default_rng(seed).integers(0, 256, (40, 36, 3), dtype=np.uint8)

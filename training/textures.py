@@ -69,8 +69,11 @@ def sample_bilinear(image, crop, x, y):
     tiled by mirroring inside crop (x, y, w, h)."""
     cx, cy, cw, ch = crop
     h, w = image.shape[1:]
-    x = mirror(x, max(cw - 1, 1)) + cx
-    y = mirror(y, max(ch - 1, 1)) + cy
+    # Clamped to the last texel (what grid_sample's border padding reads anyway): a crop
+    # scaled to a coarse mip level can reach past it, and samples all past it left the
+    # patch below empty (a training run stopped on it at step 4,480).
+    x = np.minimum(mirror(x, max(cw - 1, 1)) + cx, w - 1)
+    y = np.minimum(mirror(y, max(ch - 1, 1)) + cy, h - 1)
     # Only the texels in reach are converted to float for grid_sample.
     x0, y0 = int(x.min()), int(y.min())
     x1, y1 = min(w, int(x.max()) + 2), min(h, int(y.max()) + 2)
