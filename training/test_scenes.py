@@ -155,6 +155,11 @@ class Texturing(unittest.TestCase):
         got = textures.sample_bilinear(torch.from_numpy(image), (2.5, 0.0, 5.5, 4.0), x, np.zeros(5, np.float32))
         edge = (image[:, 0, 6].astype(np.float64) / 255) ** 2
         np.testing.assert_allclose(got, np.repeat(edge[:, None], 5, axis=1), atol=1e-6)
+        # Huge coordinates, whose float32 mirrored repeat falls up to 64 texels below 0.
+        huge = np.array([-2.2536290e+08, -2.1325616e+08, 3.2158978e+07], np.float32)
+        self.assertLess(float(textures.mirror(huge, 6.0).min()), 0)
+        got = textures.sample_bilinear(torch.from_numpy(image), (0.0, 0.0, 7.0, 4.0), huge, np.zeros(3, np.float32))
+        self.assertEqual(got.shape, (3, 3))
 
     def test_mip_levels_average_two_by_two_blocks(self):
         seed = 3

@@ -69,11 +69,13 @@ def sample_bilinear(image, crop, x, y):
     tiled by mirroring inside crop (x, y, w, h)."""
     cx, cy, cw, ch = crop
     h, w = image.shape[1:]
-    # Clamped to the last texel (what grid_sample's border padding reads anyway): a crop
-    # scaled to a coarse mip level can reach past it, and samples all past it left the
-    # patch below empty (a training run stopped on it at step 4,480).
-    x = np.minimum(mirror(x, max(cw - 1, 1)) + cx, w - 1)
-    y = np.minimum(mirror(y, max(ch - 1, 1)) + cy, h - 1)
+    # Clamped to the image (what grid_sample's border padding reads anyway): a crop scaled
+    # to a coarse mip level can reach past the last texel, and in float32 the mirrored
+    # repeat of a huge coordinate (a far surface at a grazing angle) can come out a few
+    # texels below 0, whose negative slice start left the patch below empty (a training
+    # run stopped on it at step 4,480).
+    x = np.clip(mirror(x, max(cw - 1, 1)) + cx, 0, w - 1)
+    y = np.clip(mirror(y, max(ch - 1, 1)) + cy, 0, h - 1)
     # Only the texels in reach are converted to float for grid_sample.
     x0, y0 = int(x.min()), int(y.min())
     x1, y1 = min(w, int(x.max()) + 2), min(h, int(y.max()) + 2)
