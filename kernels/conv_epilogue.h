@@ -40,18 +40,18 @@ constexpr int kActivationAtRunTime = -1;
 // networks' GEMMs and Winograd convolutions use (None, ReLU, HardSwish, GELU) and
 // kActivationAtRunTime for the others. A GEMM tile compiled for one kind keeps its
 // accumulators in registers through the epilogue; with the dispatch per row
-// (activate_tile) GCC spilled them (AVX-512, 1x1 16->64 hard-swish at 512x384: 4.8 ->
-// 2.3 ms on 1 thread). Winograd's output transform gains about 4% (3x3 64->64 at
+// (activate_tile) GCC spilled them (AVX-512, 1x1 16->64 hard-swish at 512x384: 4.4-4.7
+// -> 2.4-2.8 ms on 1 thread). Winograd's output transform gains about 4% (3x3 64->64 at
 // 148x148).
 template <class F>
 void with_fixed_activation(Activation kind, F&& f) {
-  const auto fixed = [&](auto k) { return f(std::integral_constant<int, static_cast<int>(decltype(k)::value)>{}); };
+  using std::integral_constant;
   switch (kind) {
-    case Activation::None: return fixed(std::integral_constant<Activation, Activation::None>{});
-    case Activation::ReLU: return fixed(std::integral_constant<Activation, Activation::ReLU>{});
-    case Activation::HardSwish: return fixed(std::integral_constant<Activation, Activation::HardSwish>{});
-    case Activation::GELU: return fixed(std::integral_constant<Activation, Activation::GELU>{});
-    default: return f(std::integral_constant<int, kActivationAtRunTime>{});
+    case Activation::None: return f(integral_constant<int, static_cast<int>(Activation::None)>{});
+    case Activation::ReLU: return f(integral_constant<int, static_cast<int>(Activation::ReLU)>{});
+    case Activation::HardSwish: return f(integral_constant<int, static_cast<int>(Activation::HardSwish)>{});
+    case Activation::GELU: return f(integral_constant<int, static_cast<int>(Activation::GELU)>{});
+    default: return f(integral_constant<int, kActivationAtRunTime>{});
   }
 }
 

@@ -12,7 +12,7 @@
 // argument for the kinds the networks use (with_fixed_activation, conv_epilogue.h): a
 // switch per row in the epilogue made GCC spill accumulators. Short reductions gain most:
 // 96 x 1370 on 1 thread (attention's Q K^T shape, no activation) 243 -> 256 GFLOP/s at
-// k = 64, 214 -> 241 at k = 32; ViT-S's fc1 with GELU 7.25 -> 6.97 ms.
+// k = 64, 214 -> 241 at k = 32; ViT-S's fc1 with GELU 7.1-7.4 -> 6.7-6.8 ms.
 #include <algorithm>
 
 #include "kernels/conv_epilogue.h"
