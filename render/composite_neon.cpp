@@ -1,6 +1,11 @@
 // NEON variant of the compositor kernels (AArch64): coordinates for 4 pixels at once,
 // then one footprint per pixel, each pixel's BGRA in one float32x4 register; a 128-bit
 // load brings a pixel and its right neighbour as 8 halves.
+//
+// Cycle budget (bench/arm_model.py, llvm-mca's Neoverse-N1 model for Cortex-A76): FCVTL,
+// FRINTM, FCVTZS, MLA and FDIV issue on one of the two vector pipes (V0) only, and
+// the 16 FCVTLs of four footprints alone took 32 of its cycles. The halves are widened
+// on the integer side instead (widen_scaled), which V1 takes.
 #include <arm_neon.h>
 
 #include <cstdint>
@@ -44,9 +49,8 @@ RowMap row_map(const PlaneView& plane, const InverseHomography& h, int y) {
   return r;
 }
 
-Footprints locate(const RowMap& r, int x) {
-  const float lane_offsets[4] = {0, 1, 2, 3};
-  const float32x4_t xs = vaddq_f32(vdupq_n_f32(static_cast<float>(x)), vld1q_f32(lane_offsets));
+// The footprints of output columns xs (whole numbers, exact in float below 2^24).
+Footprints locate(const RowMap& r, float32x4_t xs) {
   const float32x4_t px = vfmaq_f32(r.row_x, r.m0, xs);
   const float32x4_t py = vfmaq_f32(r.row_y, r.m3, xs);
   const float32x4_t pw = vfmaq_f32(r.row_w, r.m6, xs);
@@ -71,16 +75,34 @@ Footprints locate(const RowMap& r, int x) {
   return f;
 }
 
+// Four halves widened to floats scaled by 2^-112, by shifting bits instead of FCVTL:
+// a half's exponent and mantissa (its low 15 bits; the sign is masked, a layer holds no
+// negative value but may hold -0) moved up 13 bits are the float with the half's
+// exponent field, which reads 2^(15 - 127) times the half's value. Exact for every
+// finite half, subnormals included.
+inline float32x4_t widen_scaled(uint16x4_t halves) {
+  return vreinterpretq_f32_u32(vshll_n_u16(halves, 13));
+}
+inline float32x4_t widen_scaled_high(uint16x8_t halves) {
+  return vreinterpretq_f32_u32(vshll_high_n_u16(halves, 13));
+}
+const float kUnscale = 0x1p112f;
+
+// The bilinear sample, computed on the scaled values and scaled back once. Scaling by a
+// power of two commutes with rounding while the values stay normal floats (a half down
+// to 2^-14), so the sample rounds as the reference's except below that, where the
+// difference is under 2^-37.
 float32x4_t sample(const PlaneView& plane, int32_t index, float ax_value, float ay_value) {
   const uint16_t* p = plane.origin + 4 * static_cast<int64_t>(index);
-  const float16x8_t top = vreinterpretq_f16_u16(vld1q_u16(p));
-  const float16x8_t bottom = vreinterpretq_f16_u16(vld1q_u16(p + 4 * plane.stride));
-  const float32x4_t tl = vcvt_f32_f16(vget_low_f16(top)), tr = vcvt_high_f32_f16(top);
-  const float32x4_t bl = vcvt_f32_f16(vget_low_f16(bottom)), br = vcvt_high_f32_f16(bottom);
+  const uint16x8_t magnitude = vdupq_n_u16(0x7fff);
+  const uint16x8_t top = vandq_u16(vld1q_u16(p), magnitude);
+  const uint16x8_t bottom = vandq_u16(vld1q_u16(p + 4 * plane.stride), magnitude);
+  const float32x4_t tl = widen_scaled(vget_low_u16(top)), tr = widen_scaled_high(top);
+  const float32x4_t bl = widen_scaled(vget_low_u16(bottom)), br = widen_scaled_high(bottom);
   const float32x4_t ax = vdupq_n_f32(ax_value), ay = vdupq_n_f32(ay_value);
   const float32x4_t t = vfmaq_f32(tl, ax, vsubq_f32(tr, tl));
   const float32x4_t b = vfmaq_f32(bl, ax, vsubq_f32(br, bl));
-  return vfmaq_f32(t, ay, vsubq_f32(b, t));
+  return vmulq_n_f32(vfmaq_f32(t, ay, vsubq_f32(b, t)), kUnscale);
 }
 
 // accum = sample + accum * (1 - sample.alpha)
@@ -100,12 +122,21 @@ uint8x8_t round_to_bytes(float32x4_t lo, float32x4_t hi) {
 void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, int x_begin,
                    int count, float* accum) {
   const RowMap r = row_map(plane, h, y);
-  for (int i = 0; i < count; i += 4) {
-    const Footprints f = locate(r, x_begin + i);
-    const int n = count - i < 4 ? count - i : 4;
-    for (int k = 0; k < n; ++k)
-      over(accum + 4 * (i + k), sample(plane, f.top_left[k], f.ax[k], f.ay[k]));
+  const float lane_offsets[4] = {0, 1, 2, 3};
+  float32x4_t xs = vaddq_f32(vdupq_n_f32(static_cast<float>(x_begin)), vld1q_f32(lane_offsets));
+  // The next four footprints are located before this four are sampled: one group's
+  // chain (divide, floor, index, load, blend) is longer than an out-of-order core's
+  // window, and this way two groups' chains overlap.
+  Footprints f = locate(r, xs);
+  int i = 0;
+  for (; i + 4 <= count; i += 4) {
+    xs = vaddq_f32(xs, vdupq_n_f32(4.0f));
+    const Footprints next = locate(r, xs);
+    for (int k = 0; k < 4; ++k) over(accum + 4 * (i + k), sample(plane, f.top_left[k], f.ax[k], f.ay[k]));
+    f = next;
   }
+  for (int k = 0; i + k < count; ++k)
+    over(accum + 4 * (i + k), sample(plane, f.top_left[k], f.ax[k], f.ay[k]));
 }
 
 void shift_over_row(const PlaneView& plane, float du, float dv, int y, int x_begin, int count,

@@ -180,6 +180,33 @@ TEST_CASE("every translation kernel matches the scalar reference") {
   }
 }
 
+TEST_CASE("halves at the ends of their range composite as the reference's") {
+  // Negative zero, subnormals, the smallest normal and one: the NEON variant widens
+  // halves by shifting their bits (composite_neon.cpp), where a sign bit or a subnormal
+  // would go wrong first.
+  const uint16_t ends[] = {0x8000, 0x0001, 0x0155, 0x03ff, 0x0400, 0x1400, 0x3c00};
+  PaddedPlane plane(9, 5, 5);
+  for (size_t i = 0; i < plane.pixels.size(); ++i)
+    if (plane.pixels[i] != 0) plane.pixels[i] = ends[i % 7];  // the border stays zero
+  std::mt19937 rng(5);
+  const render::CompositeKernels reference = render::composite_kernels(Isa::Scalar);
+  for (Isa isa : runnable_isas()) {
+    const render::CompositeKernels k = render::composite_kernels(isa);
+    for (const render::InverseHomography& h : sweep_maps(9, 5, rng))
+      for (int y = -1; y <= 5; ++y) {
+        INFO("isa " << isa_name(isa) << ", y " << y);
+        std::vector<float> expected(4 * 13, 0.25f), got = expected;
+        reference.warp_over_row(plane.view, h, y, -2, 13, expected.data());
+        k.warp_over_row(plane.view, h, y, -2, 13, got.data());
+        CHECK(test::max_abs_diff(expected.data(), got.data(), expected.size()) <= 1e-4f);
+        expected.assign(4 * 13, 0.25f), got = expected;
+        reference.shift_over_row(plane.view, 0.375f, 0.5f, y, -2, 13, expected.data());
+        k.shift_over_row(plane.view, 0.375f, 0.5f, y, -2, 13, got.data());
+        CHECK(test::max_abs_diff(expected.data(), got.data(), expected.size()) <= 1e-4f);
+      }
+  }
+}
+
 TEST_CASE("accumulators outside [0, 1] saturate to black and white") {
   const std::vector<float> accum = {-0.5f, 1.5f, 0.5f, 1.0f, 2.0f, -3.0f, 1.0f, 0.0f};
   for (Isa isa : runnable_isas()) {
