@@ -32,27 +32,30 @@ inline void activate_tile(Vec (&v)[N], ActivationSpec act, Activate activate) {
   }
 }
 
-// An epilogue's activation kind as a template argument: one of the kinds below, or
+// An epilogue's activation kind as a template argument: one of a FixedActivations set, or
 // kActivationAtRunTime (read from the arguments, by activate_tile).
 constexpr int kActivationAtRunTime = -1;
 
-// f(std::integral_constant<int, kind>) with the kind fixed at compile time for those the
-// networks' GEMMs and Winograd convolutions use (None, ReLU, HardSwish, GELU) and
-// kActivationAtRunTime for the others. A GEMM tile compiled for one kind keeps its
-// accumulators in registers through the epilogue; with the dispatch per row
-// (activate_tile) GCC spilled them (AVX-512, 1x1 16->64 hard-swish at 512x384: 4.4-4.7
-// -> 2.4-2.8 ms on 1 thread). Winograd's output transform gains about 4% (3x3 64->64 at
-// 148x148).
-template <class F>
-void with_fixed_activation(Activation kind, F&& f) {
-  using std::integral_constant;
-  switch (kind) {
-    case Activation::None: return f(integral_constant<int, static_cast<int>(Activation::None)>{});
-    case Activation::ReLU: return f(integral_constant<int, static_cast<int>(Activation::ReLU)>{});
-    case Activation::HardSwish: return f(integral_constant<int, static_cast<int>(Activation::HardSwish)>{});
-    case Activation::GELU: return f(integral_constant<int, static_cast<int>(Activation::GELU)>{});
-    default: return f(integral_constant<int, kActivationAtRunTime>{});
-  }
+// A set of activation kinds that a kernel compiles an epilogue of its own for.
+template <Activation... kKinds>
+struct FixedActivations {};
+// The kinds the networks' GEMMs and Winograd convolutions use. A GEMM tile compiled for
+// one kind keeps its accumulators in registers through the epilogue; with the dispatch
+// per row (activate_tile) GCC spilled them (AVX-512, 1x1 16->64 hard-swish at 512x384:
+// 4.4-4.7 -> 2.4-2.8 ms on 1 thread). Winograd's output transform gains about 4% (3x3
+// 64->64 at 148x148).
+inline constexpr FixedActivations<Activation::None, Activation::ReLU, Activation::HardSwish, Activation::GELU>
+    kGemmActivations{};
+// The kinds the depthwise convolutions of the networks use (MobileNet blocks).
+inline constexpr FixedActivations<Activation::None, Activation::ReLU, Activation::ReLU6, Activation::HardSwish>
+    kDepthwiseActivations{};
+
+// f(std::integral_constant<int, kind>): the kind fixed at compile time when it is one of
+// the set, kActivationAtRunTime for the others.
+template <Activation... kKinds, class F>
+void with_fixed_activation(FixedActivations<kKinds...>, Activation kind, F&& f) {
+  const bool fixed = ((kind == kKinds && (f(std::integral_constant<int, static_cast<int>(kKinds)>{}), true)) || ...);
+  if (!fixed) f(std::integral_constant<int, kActivationAtRunTime>{});
 }
 
 // activate(v, act) with the kind fixed at compile time unless kKind is kActivationAtRunTime.

@@ -1,8 +1,8 @@
 // Depthwise convolution row (DepthwiseRowArgs, kernels/kernel_table.h), written once for
 // AVX2, AVX-512 and NEON over the lane-generic channel helpers. Each ISA's
 // conv_depthwise_*.cpp includes this inside its own namespace, after its *_channels.h
-// (Channels, lane accessors, plus, fmadd) and *_math.h (activate). Not a header: no
-// include guard.
+// (Channels, lane accessors, plus, fmadd), *_math.h (activate) and conv_epilogue.h
+// (with_fixed_activation). Not a header: no include guard.
 //
 // Why it is shaped this way (bench/RESULTS-kernels.md has the numbers):
 // - The whole row goes in blocks of kBlock output pixels, one channel vector at a time.
@@ -47,17 +47,15 @@ struct FixedGeometry {};
 // Any kernel width, stride and dilation, read from the arguments.
 struct AnyGeometry {};
 
-template <Activation kKind>
-struct FixedActivation {
-  float alpha;
-  template <class V>
-  V operator()(V v) const { return activate(v, ActivationSpec{kKind, alpha}); }
-};
-
-struct RuntimeActivation {
+// The epilogue's activation, its kind fixed at compile time unless kKind is
+// kActivationAtRunTime (conv_epilogue.h).
+template <int kKind>
+struct RowActivation {
   ActivationSpec spec;
   template <class V>
-  V operator()(V v) const { return activate(v, spec); }
+  V operator()(V v) const {
+    return activate_of<kKind>(v, spec, [](V x, ActivationSpec s) { return activate(x, s); });
+  }
 };
 
 // Column ix of input row `row`, channels [ch, ch + lane width); zero outside the row
@@ -257,14 +255,8 @@ void row(const DepthwiseRowArgs& d, Act act) {
 
 template <class Geometry>
 void row_for_activation(const DepthwiseRowArgs& d) {
-  const float alpha = d.act.alpha;
-  switch (d.act.kind) {
-    case Activation::None: return row<Geometry>(d, FixedActivation<Activation::None>{alpha});
-    case Activation::ReLU: return row<Geometry>(d, FixedActivation<Activation::ReLU>{alpha});
-    case Activation::ReLU6: return row<Geometry>(d, FixedActivation<Activation::ReLU6>{alpha});
-    case Activation::HardSwish: return row<Geometry>(d, FixedActivation<Activation::HardSwish>{alpha});
-    default: return row<Geometry>(d, RuntimeActivation{d.act});
-  }
+  with_fixed_activation(kDepthwiseActivations, d.act.kind,
+                        [&](auto kind) { row<Geometry>(d, RowActivation<decltype(kind)::value>{d.act}); });
 }
 
 }  // namespace depthwise

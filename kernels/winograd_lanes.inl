@@ -87,5 +87,5 @@ void output(const WinogradOutputArgs& a) {
 
 void winograd_output(const WinogradOutputArgs& o) {
   const WinogradOutputArgs a = o;  // locals: the vector stores may alias anything
-  with_fixed_activation(a.act.kind, [&](auto act) { winograd_lanes::output<decltype(act)::value>(a); });
+  with_fixed_activation(kGemmActivations, a.act.kind, [&](auto act) { winograd_lanes::output<decltype(act)::value>(a); });
 }

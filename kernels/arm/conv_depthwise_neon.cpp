@@ -3,6 +3,7 @@
 // every ISA: kernels/depthwise_lanes.inl explains its shape.
 #include <algorithm>
 
+#include "kernels/conv_epilogue.h"
 #include "kernels/arm/neon_channels.h"
 #include "kernels/arm/neon_kernels.h"
 #include "kernels/arm/neon_math.h"

@@ -94,7 +94,7 @@ void panel_tile(const GemmArgs& g, const float* panel, int j0, int columns) {
 
 void gemm(const GemmArgs& g) {
   const int64_t panel_floats = static_cast<int64_t>(1 + g.k) * kGemmNr;
-  with_fixed_activation(g.act.kind, [&](auto act) {
+  with_fixed_activation(kGemmActivations, g.act.kind, [&](auto act) {
     const float* panel = g.packed;
     for (int j0 = 0; j0 < g.n; j0 += kGemmNr, panel += panel_floats)
       panel_tile<decltype(act)::value>(g, panel, j0, std::min(kGemmNr, g.n - j0));

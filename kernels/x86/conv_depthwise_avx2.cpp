@@ -4,6 +4,7 @@
 // kernels/depthwise_lanes.inl explains its shape.
 #include <algorithm>
 
+#include "kernels/conv_epilogue.h"
 #include "kernels/x86/avx2_channels.h"
 #include "kernels/x86/avx2_kernels.h"
 #include "kernels/x86/avx2_math.h"

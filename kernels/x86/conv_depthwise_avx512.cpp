@@ -8,6 +8,7 @@
 // warning is raised where the templates are instantiated, so it is off for the file.
 #pragma GCC diagnostic ignored "-Wuninitialized"
 
+#include "kernels/conv_epilogue.h"
 #include "kernels/x86/avx512_channels.h"
 #include "kernels/x86/avx512_kernels.h"
 #include "kernels/x86/avx512_math.h"

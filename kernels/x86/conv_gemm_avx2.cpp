@@ -95,7 +95,7 @@ void panels(const GemmArgs& g) {
 void gemm(const GemmArgs& g) {
   // Into L2 (prefetcht1): the tile reads it only in the next call.
   for (int64_t i = 0; i < g.prefetch_floats; i += 16) __builtin_prefetch(g.prefetch_a + i, 0, 2);
-  with_fixed_activation(g.act.kind, [&](auto act) { panels<decltype(act)::value>(g); });
+  with_fixed_activation(kGemmActivations, g.act.kind, [&](auto act) { panels<decltype(act)::value>(g); });
 }
 
 }  // namespace ampi::avx2

@@ -117,7 +117,7 @@ void panels(const GemmArgs& g) {
 
 template <bool kStream>
 void panels(const GemmArgs& g) {
-  with_fixed_activation(g.act.kind, [&](auto act) { panels<kStream, decltype(act)::value>(g); });
+  with_fixed_activation(kGemmActivations, g.act.kind, [&](auto act) { panels<kStream, decltype(act)::value>(g); });
 }
 
 }  // namespace
