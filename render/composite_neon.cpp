@@ -124,7 +124,7 @@ void warp_over_row(const PlaneView& plane, const InverseHomography& h, int y, in
   const RowMap r = row_map(plane, h, y);
   const float lane_offsets[4] = {0, 1, 2, 3};
   float32x4_t xs = vaddq_f32(vdupq_n_f32(static_cast<float>(x_begin)), vld1q_f32(lane_offsets));
-  // The next four footprints are located before this four are sampled: one group's
+  // The next four footprints are located before these four are sampled: one group's
   // chain (divide, floor, index, load, blend) is longer than an out-of-order core's
   // window, and this way two groups' chains overlap.
   Footprints f = locate(r, xs);
