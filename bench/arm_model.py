@@ -10,8 +10,8 @@ How:
 1. Each kernel's translation unit is compiled for aarch64 the way the cross build compiles
    it (aarch64-linux-gnu-g++ -O3, armv8-a), to assembly.
 2. The hot loops are found in it: innermost loops (a label and the backward branch to
-   it, with no loop inside) of the named function, the one with the most vector floating
-   point instructions taken as the kernel's inner loop.
+   it, with no loop inside) of the named function; among those with the steady state's
+   FMA count (KERNELS), the one with the fewest instructions is the kernel's inner loop.
 3. llvm-mca predicts cycles per iteration of that loop in steady state for each core, and
    the same for a block of independent FMAs gives each core's FMA bound (FMAs per cycle).
    The loop's bound is its FMA count over that rate; the ratio is the share of the FMA
