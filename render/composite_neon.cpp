@@ -86,7 +86,7 @@ inline float32x4_t widen_scaled(uint16x4_t halves) {
 inline float32x4_t widen_scaled_high(uint16x8_t halves) {
   return vreinterpretq_f32_u32(vshll_high_n_u16(halves, 13));
 }
-const float kUnscale = 0x1p112f;
+constexpr float kUnscale = 0x1p112f;
 
 // The bilinear sample, computed on the scaled values and scaled back once. Scaling by a
 // power of two commutes with rounding while the values stay normal floats (a half down
