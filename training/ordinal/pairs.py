@@ -10,13 +10,12 @@ Pairs come from a fixed seed and each photo's own name, so `sample` always makes
 file. Per photo and round: RANDOM_PAIRS pairs of points uniform over the photo, and
 EDGE_PAIRS pairs straddling a strong image edge (the two points on either side of it,
 along the gradient), so the set also asks about object boundaries. Rounds were labelled
-one after another (round 1: pairs 1-7, round 2: 8-14, round 3: 15-21, round 4: 22-28,
-round 5: 29-35); a new round adds pairs and leaves the earlier ones, and their labels, as
-they were. The validation photos' pairs of TEST_ROUNDS are merged as a part of their own,
-split 'test'. Nothing here looks at any network's output: the labels are what a person
-(or labelling agent) sees in the marked image (INSTRUCTIONS.md). Coordinates are pixels
-of the photo upright (turned by its EXIF orientation, as `ampi` reads it; x right, y
-down).
+one after another (round 1: pairs 1-7, round 2: 8-14, ..., round 7: 43-49); a new
+round adds pairs and leaves the earlier ones, and their labels, as they were. The
+validation photos' pairs of TEST_ROUNDS are merged as a part of their own, split 'test'.
+Nothing here looks at any network's output: the labels are what a person (or labelling
+agent) sees in the marked image (INSTRUCTIONS.md). Coordinates are pixels of the photo
+upright (turned by its EXIF orientation, as `ampi` reads it; x right, y down).
 """
 
 import argparse
@@ -46,12 +45,12 @@ EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the
 EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
 ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
-ROUNDS = 5
+ROUNDS = 7
 # The validation photos' pairs of these rounds are the test part (split 'test'): no
 # network is ever selected on them. Rounds 1 and 2 of the validation photos had picked
 # the bundled networks, and on the fresh round 3 lite scored far worse than on them.
-# Round 5 joined them to halve the part's sampling error.
-TEST_ROUNDS = (3, 5)
+# Rounds 5 and 6 joined them to shrink the part's sampling error; round 7 joined `val`.
+TEST_ROUNDS = (3, 5, 6)
 PAIRS_PER_ROUND = RANDOM_PAIRS + EDGE_PAIRS
 LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
 PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
