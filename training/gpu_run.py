@@ -186,7 +186,8 @@ def depth_command(args, model: str, workers: int) -> str:
             f"--device {args.device} --threads {args.threads} --workers {workers} --scene-reuse {args.scene_reuse} "
             f"--ema {args.ema}{decay} "
             f"--minutes {args.minutes} --val-every {args.val_every} --val-count {args.val_count} "
-            f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch}")
+            f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
+            f"--rank-weight {args.rank_weight:g}")
 
 
 def inpaint_command(args, workers: int) -> str:
@@ -323,6 +324,8 @@ def main(argv=None):
     depth.add_argument("--size", default="256x192")
     depth.add_argument("--batch", type=int, default=48)
     depth.add_argument("--ordinal-batch", type=int, default=16)
+    depth.add_argument("--rank-weight", type=float, default=8.0,
+                       help="weight of the ranking loss on the photos' pairs (the bundled lite's run: 8)")
     depth.add_argument("--val-every", type=int, default=500)
     inpaint = pack.add_argument_group("the inpainting run")
     inpaint.add_argument("--disparity-dir", default=inpaint_data.DEFAULT_DISPARITY_DIR,

@@ -113,6 +113,7 @@ class RoundTrip(unittest.TestCase):
             self.assertIn("initialised lite from weights/depth_lite.ampw", log)
             self.assertIn("(slim: Adam restarts)", log)
             self.assertIn("weights averaged (decay 0.999)", log)
+            self.assertIn("rank weight 8)", log)
             self.assertIn("cosine decay from 1.00e-03 to 1.00e-05 at step 1000", log)
             self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
             self.assertIn("ordinal_whdr", log)
