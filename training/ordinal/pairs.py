@@ -45,12 +45,13 @@ EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the
 EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
 ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
-ROUNDS = 7
+ROUNDS = 9
 # The validation photos' pairs of these rounds are the test part (split 'test'): no
 # network is ever selected on them. Rounds 1 and 2 of the validation photos had picked
 # the bundled networks, and on the fresh round 3 lite scored far worse than on them.
-# Rounds 5 and 6 joined them to shrink the part's sampling error; round 7 joined `val`.
-TEST_ROUNDS = (3, 5, 6)
+# Rounds 5, 6 and 8 joined them to shrink the part's sampling error; rounds 7 and 9
+# joined `val`.
+TEST_ROUNDS = (3, 5, 6, 8)
 PAIRS_PER_ROUND = RANDOM_PAIRS + EDGE_PAIRS
 LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
 PALETTE = [(255, 40, 40), (40, 220, 40), (60, 120, 255), (255, 220, 0), (255, 0, 255),
