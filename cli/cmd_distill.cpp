@@ -35,27 +35,31 @@ namespace fs = std::filesystem;
 
 const char kUsage[] =
     "usage: ampi distill --teacher FILE.ampw --images DIR -o LABELS\n"
-    "                    [--resolutions LIST] [--threads N]\n"
+    "                    [--resolutions LIST] [--keep-aspect] [--threads N]\n"
     "\n"
     "Labels every photo under DIR (searched recursively, .jpg .jpeg .png) with the paper's\n"
-    "pseudo ground truth: the teacher runs at each square resolution on the photo and its\n"
-    "mirror image, each prediction is normalised by its median and mean absolute deviation,\n"
-    "and the per-pixel median of all of them, at the photo's size, is written as a 16-bit\n"
-    "PNG (0..65535, larger = nearer). LABELS/labels.tsv records the teacher, the\n"
-    "resolutions and each photo's label; a second run with the same teacher skips what is\n"
-    "done, so a stopped run resumes. training/train_depth.py trains on LABELS with\n"
-    "--data distilled:LABELS.\n"
+    "pseudo ground truth: the teacher runs at each square resolution on the photo (area-\n"
+    "averaged first down to the largest side) and on its mirror image, each prediction is\n"
+    "normalised by its median and mean absolute deviation, and the per-pixel median of all\n"
+    "of them, at the photo's size, is written as a 16-bit PNG (0..65535, larger = nearer).\n"
+    "LABELS/labels.tsv records the teacher, the resolutions and each photo's label; a\n"
+    "second run with the same teacher skips what is done, so a stopped run resumes.\n"
+    "training/train_depth.py trains on LABELS with --data distilled:LABELS, or on the\n"
+    "ordinal set's training photos beside their pairs with --teacher-labels LABELS.\n"
     "\n"
     "  --teacher FILE    a depth weight file of any depth architecture (a Depth Anything V2\n"
     "                    file from training/import_depth_anything.py, or lite/heavy)\n"
     "  --images DIR      the photos\n"
     "  -o LABELS         the label folder: new, empty, or one this command made\n"
     "  --resolutions L   comma-separated square sides (default " DEFAULT_RESOLUTIONS ")\n"
+    "  --keep-aspect     the resolutions are long sides, the photo's aspect kept (for\n"
+    "                    networks trained on whole photos: lite and heavy)\n"
     "  --threads N       worker threads (default: all hardware threads)\n";
 
 struct DistillOptions {
   std::string teacher, images, labels;
   std::vector<int> resolutions;
+  EnsembleShape shape = EnsembleShape::kSquare;
   int threads = 0;
 };
 
@@ -90,6 +94,7 @@ DistillOptions parse(int argc, char** argv, bool& help) {
   p.option("-o", &o.labels);
   p.option("--output", &o.labels);
   p.option("--resolutions", [&](const std::string& v) { o.resolutions = parse_resolutions(v); });
+  p.flag("--keep-aspect", [&] { o.shape = EnsembleShape::kAspectKept; });
   p.option("--threads", &o.threads, 1, 1024);
   p.positionals(&extra);
   help = !p.parse(argc, argv);
@@ -134,6 +139,27 @@ cv::Mat rgb_float(const cv::Mat& bgr) {
   return out;
 }
 
+// The photo brought down by area averaging until its long side is at most `long_side`.
+// The ensemble's bilinear squares would alias a large photo (a 4000-px wallpaper sampled
+// at 256 px keeps one pixel in 16 and loses everything between).
+cv::Mat area_shrunk(const cv::Mat& photo, int long_side) {
+  const double scale = static_cast<double>(long_side) / std::max(photo.rows, photo.cols);
+  if (scale >= 1.0) return photo;
+  cv::Mat out;
+  cv::resize(photo, out, cv::Size(std::max(1, cvRound(photo.cols * scale)), std::max(1, cvRound(photo.rows * scale))), 0,
+             0, cv::INTER_AREA);
+  return out;
+}
+
+// The pseudo ground truth of a photo at the photo's own size.
+cv::Mat label_of(const cv::Mat& photo, const Teacher& teacher, const std::vector<int>& resolutions,
+                 EnsembleShape shape) {
+  const int largest = *std::max_element(resolutions.begin(), resolutions.end());
+  cv::Mat label = pseudo_ground_truth(rgb_float(area_shrunk(photo, largest)), teacher, resolutions, shape);
+  if (label.size() != photo.size()) cv::resize(label, label, photo.size(), 0, 0, cv::INTER_LINEAR);
+  return label;
+}
+
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
@@ -148,7 +174,7 @@ int cmd_distill(int argc, char** argv) {
   const std::unique_ptr<DepthModel> net = load_depth_model(o.teacher);
   for (int side : o.resolutions) set_working_size_option(*net, side, "--resolutions");  // before any photo
   const LabelRecipe recipe{fs::path(o.teacher).filename().string(), net->architecture(), net->variant(),
-                           o.resolutions, fs::absolute(o.images).lexically_normal().string()};
+                           o.resolutions, o.shape, fs::absolute(o.images).lexically_normal().string()};
   LabelFolder labels(o.labels, recipe);
   ThreadPool pool(o.threads);
   const Teacher teacher = teacher_of(*net, pool);
@@ -157,7 +183,7 @@ int cmd_distill(int argc, char** argv) {
     if (labels.has(photos[i])) continue;
     const auto start = std::chrono::steady_clock::now();
     const cv::Mat photo = read_photo((fs::path(o.images) / photos[i]).string());
-    labels.add(photos[i], pseudo_ground_truth(rgb_float(photo), teacher, o.resolutions));
+    labels.add(photos[i], label_of(photo, teacher, o.resolutions, o.shape));
     std::fprintf(stderr, "ampi distill: [%zu/%zu] %s %.1f s\n", i + 1, photos.size(), photos[i].c_str(),
                  seconds_since(start));
   }

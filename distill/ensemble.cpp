@@ -28,14 +28,14 @@ double median_of(std::vector<double>& values) {
   return 0.5 * (upper + *std::max_element(values.begin(), values.begin() + half));
 }
 
-// One prediction of the ensemble, back in the orientation of `square`.
-cv::Mat predict(const Teacher& teacher, const cv::Mat& square, bool mirrored) {
-  cv::Mat input = square;
-  if (mirrored) cv::flip(square, input, 1);
+// One prediction of the ensemble, back in the orientation of `scaled`.
+cv::Mat predict(const Teacher& teacher, const cv::Mat& scaled, bool mirrored) {
+  cv::Mat input = scaled;
+  if (mirrored) cv::flip(scaled, input, 1);
   cv::Mat d = teacher(input);
   if (d.type() != CV_32FC1 || d.empty())
     throw std::runtime_error("distill: the teacher returned no one-channel float map");
-  d = resize_bilinear(d, square.rows, square.cols);
+  d = resize_bilinear(d, scaled.rows, scaled.cols);
   if (mirrored) cv::flip(d, d, 1);
   return d;
 }
@@ -78,20 +78,39 @@ cv::Mat normalise_median_mad(const cv::Mat& disparity) {
   return out;
 }
 
-cv::Mat ensemble_median(const cv::Mat& rgb, const Teacher& teacher, const std::vector<int>& resolutions) {
-  check_inputs(rgb, resolutions);
-  const int largest = *std::max_element(resolutions.begin(), resolutions.end());
-  std::vector<cv::Mat> predictions;
+std::vector<cv::Size> ensemble_sizes(cv::Size photo, const std::vector<int>& resolutions, EnsembleShape shape) {
+  std::vector<cv::Size> sizes;
+  const double long_side = std::max(photo.width, photo.height);
   for (int side : resolutions) {
-    const cv::Mat square = resize_bilinear(rgb, side, side);
+    if (shape == EnsembleShape::kSquare) {
+      sizes.emplace_back(side, side);
+    } else {  // Python's round: half to even, as training/distill.py rounds
+      const auto scaled = [&](int n) { return std::max(1, static_cast<int>(std::nearbyint(n * side / long_side))); };
+      sizes.emplace_back(scaled(photo.width), scaled(photo.height));
+    }
+  }
+  return sizes;
+}
+
+cv::Mat ensemble_median(const cv::Mat& rgb, const Teacher& teacher, const std::vector<int>& resolutions,
+                        EnsembleShape shape) {
+  check_inputs(rgb, resolutions);
+  const std::vector<cv::Size> sizes = ensemble_sizes(rgb.size(), resolutions, shape);
+  const cv::Size largest = *std::max_element(sizes.begin(), sizes.end(),
+                                             [](cv::Size a, cv::Size b) { return a.area() < b.area(); });
+  std::vector<cv::Mat> predictions;
+  for (cv::Size size : sizes) {
+    const cv::Mat scaled = resize_bilinear(rgb, size.height, size.width);
     for (bool mirrored : {false, true})
-      predictions.push_back(resize_bilinear(normalise_median_mad(predict(teacher, square, mirrored)), largest, largest));
+      predictions.push_back(
+          resize_bilinear(normalise_median_mad(predict(teacher, scaled, mirrored)), largest.height, largest.width));
   }
   return per_pixel_median(predictions);
 }
 
-cv::Mat pseudo_ground_truth(const cv::Mat& rgb, const Teacher& teacher, const std::vector<int>& resolutions) {
-  const cv::Mat d = resize_bilinear(ensemble_median(rgb, teacher, resolutions), rgb.rows, rgb.cols);
+cv::Mat pseudo_ground_truth(const cv::Mat& rgb, const Teacher& teacher, const std::vector<int>& resolutions,
+                            EnsembleShape shape) {
+  const cv::Mat d = resize_bilinear(ensemble_median(rgb, teacher, resolutions, shape), rgb.rows, rgb.cols);
   double lo = 0, hi = 0;
   cv::minMaxLoc(d, &lo, &hi);
   cv::Mat out;

@@ -25,7 +25,8 @@ std::string join(const std::vector<int>& values) {
 // The four header lines after the format line.
 std::vector<std::string> header_lines(const LabelRecipe& r) {
   return {"teacher\t" + r.teacher_file + "\t" + r.architecture + "\t" + r.variant,
-          "resolutions\t" + join(r.resolutions), "images\t" + r.images};
+          "resolutions\t" + join(r.resolutions) + (r.shape == EnsembleShape::kAspectKept ? "\taspect kept" : ""),
+          "images\t" + r.images};
 }
 
 [[noreturn]] void fail(const std::string& path, const std::string& problem) {

@@ -5,7 +5,7 @@
 //
 //   ampi-distill	1
 //   teacher	FILE NAME	ARCH	VARIANT
-//   resolutions	518,434,...
+//   resolutions	518,434,...	(a third field "aspect kept" for EnsembleShape::kAspectKept)
 //   images	/absolute/path/of/the/photo/folder
 //   LABEL.png	PHOTO PATH RELATIVE TO images
 //   ...
@@ -28,6 +28,7 @@ struct LabelRecipe {
   std::string teacher_file;  // the weight file's name (no folder)
   std::string architecture, variant;
   std::vector<int> resolutions;
+  EnsembleShape shape = EnsembleShape::kSquare;
   std::string images;  // the photo folder, absolute
 };
 

@@ -1,10 +1,11 @@
 """The paper's pseudo-ground-truth builder: a 10x ensemble of a teacher's predictions.
 
 For each photo the teacher runs at five square resolutions (default 512, 768, 1024, 1600,
-1920, as in the paper) on the image and on its horizontal mirror (the mirrored prediction
-is flipped back). Each of the ten predictions is normalised on its own, resized bilinearly
-to the largest resolution, and the ten are combined by the per-pixel median. The result
-is finally resized to the photo's own size.
+1920, as in the paper; or with keep_aspect at those long sides, the photo's aspect kept)
+on the image and on its horizontal mirror (the mirrored prediction is flipped back). Each
+of the ten predictions is normalised on its own, resized bilinearly to the largest size,
+and the ten are combined by the per-pixel median. The result is finally resized to the
+photo's own size.
 
 Normalisation: median and mean absolute deviation, d' = (d - median(d)) / MAD(d), the
 scale-and-shift alignment MiDaS uses for its own targets. It makes predictions at
@@ -52,32 +53,44 @@ def normalise_median_mad(disparity: np.ndarray, eps: float = 1e-8) -> np.ndarray
     return ((d - median) / max(mad, eps)).astype(np.float32)
 
 
+def ensemble_sizes(height: int, width: int, resolutions: Sequence[int], keep_aspect: bool = False):
+    """The (h, w) the teacher sees for each resolution: the paper's squares, or with
+    keep_aspect the photo brought to that long side, its aspect kept (networks trained
+    on whole photos of one aspect, as ours are, do worse on squeezed squares)."""
+    if not keep_aspect:
+        return [(side, side) for side in resolutions]
+    long_side = max(height, width)
+    return [(max(1, round(height * side / long_side)), max(1, round(width * side / long_side)))
+            for side in resolutions]
+
+
 def ensemble_predictions(rgb: np.ndarray, teacher: Teacher,
-                         resolutions: Sequence[int] = PAPER_RESOLUTIONS) -> np.ndarray:
-    """The ten normalised predictions, each at the largest square resolution: [10, S, S]."""
+                         resolutions: Sequence[int] = PAPER_RESOLUTIONS, keep_aspect: bool = False) -> np.ndarray:
+    """The normalised predictions, two per resolution, each at the largest size: [2R, H, W]."""
     if rgb.ndim != 3 or rgb.shape[2] != 3:
         raise ValueError(f"expected an H x W x 3 image, got shape {rgb.shape}")
-    largest = max(resolutions)
+    sizes = ensemble_sizes(rgb.shape[0], rgb.shape[1], resolutions, keep_aspect)
+    largest = max(sizes, key=lambda size: size[0] * size[1])
     predictions = []
-    for side in resolutions:
-        square = resize_bilinear(rgb, side, side)
+    for height, width in sizes:
+        scaled = resize_bilinear(rgb, height, width)
         for flipped in (False, True):
-            x = square[:, ::-1] if flipped else square
+            x = scaled[:, ::-1] if flipped else scaled
             d = np.asarray(teacher(np.ascontiguousarray(x)), dtype=np.float32)
             if d.ndim != 2:
                 raise ValueError(f"the teacher returned shape {d.shape}, expected a 2-D disparity")
-            if d.shape != (side, side):
-                d = resize_bilinear(d, side, side)
+            if d.shape != (height, width):
+                d = resize_bilinear(d, height, width)
             if flipped:
                 d = d[:, ::-1]
-            predictions.append(resize_bilinear(normalise_median_mad(d), largest, largest))
+            predictions.append(resize_bilinear(normalise_median_mad(d), *largest))
     return np.stack(predictions)
 
 
 def pseudo_ground_truth(rgb: np.ndarray, teacher: Teacher,
-                        resolutions: Sequence[int] = PAPER_RESOLUTIONS) -> np.ndarray:
+                        resolutions: Sequence[int] = PAPER_RESOLUTIONS, keep_aspect: bool = False) -> np.ndarray:
     """The per-pixel median of the ensemble, at the photo's own size, mapped to [0, 1]."""
-    median = np.median(ensemble_predictions(rgb, teacher, resolutions), axis=0)
+    median = np.median(ensemble_predictions(rgb, teacher, resolutions, keep_aspect), axis=0)
     d = resize_bilinear(median, rgb.shape[0], rgb.shape[1])
     lo, hi = float(d.min()), float(d.max())
     return ((d - lo) / max(hi - lo, 1e-8)).astype(np.float32)
@@ -102,6 +115,29 @@ def network_teacher(checkpoint: str, model_name: str = "heavy", multiple: int = 
     return teacher
 
 
+def read_label_folder(folder) -> tuple[Path, dict]:
+    """An `ampi distill` label folder: (its photo folder, {photo path relative to that
+    folder: label file}), from the folder's labels.tsv (distill/label_folder.h)."""
+    lines = (Path(folder) / "labels.tsv").read_text().splitlines()
+    if not lines or lines[0] != "ampi-distill\t1":
+        raise ValueError(f"{folder}/labels.tsv: not a label folder of ampi distill")
+    header = dict(line.split("\t", 1) for line in lines[1:4])
+    labels = {}
+    for line in lines[4:]:
+        label, photo = line.split("\t")
+        labels[photo] = Path(folder) / label
+    return Path(header["images"]), labels
+
+
+def read_disparity(path: Path) -> np.ndarray:
+    """A float32 H x W disparity from NAME.npy or a 16-bit PNG (scaled to [0, 1])."""
+    if path.suffix == ".npy":
+        return np.load(path).astype(np.float32)
+    from PIL import Image
+    with Image.open(path) as image:
+        return np.asarray(image, dtype=np.float32) / 65535.0
+
+
 def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequence[int]):
     from PIL import Image, ImageOps  # Debian's python3-pil
     out.mkdir(parents=True, exist_ok=True)
@@ -111,8 +147,15 @@ def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequenc
         target = out / f"{stem}.npy"
         if target.exists():
             continue  # resumable: finished photos are kept
-        rgb = np.asarray(ImageOps.exif_transpose(Image.open(path)).convert("RGB"), dtype=np.float32) / 255.0
-        np.save(target, pseudo_ground_truth(rgb, teacher, resolutions))
+        image = ImageOps.exif_transpose(Image.open(path)).convert("RGB")
+        full_size = image.size
+        # area-averaged down to the largest square first, as `ampi distill` does: the
+        # bilinear squares would alias a large photo
+        scale = max(resolutions) / max(full_size)
+        if scale < 1:
+            image = image.resize((max(1, round(image.width * scale)), max(1, round(image.height * scale))), Image.BOX)
+        label = pseudo_ground_truth(np.asarray(image, dtype=np.float32) / 255.0, teacher, resolutions)
+        np.save(target, resize_bilinear(label, full_size[1], full_size[0]))
         link = out / f"{stem}{path.suffix.lower()}"
         if not link.exists():
             link.symlink_to(path.resolve())

@@ -18,16 +18,19 @@ import torch
 import torch.nn.functional as F
 from PIL import Image, ImageOps
 
+import distill
+
 ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json"
 PHOTO_MAX_SIDE = 640      # photos are kept decoded at this size (training crops are smaller)
 CROP_SHARE = (0.7, 1.0)   # a training crop keeps this share of each side
 
 
 class OrdinalPhoto:
-    def __init__(self, rgb: np.ndarray, points: np.ndarray, signs: np.ndarray):
+    def __init__(self, rgb: np.ndarray, points: np.ndarray, signs: np.ndarray, teacher=None):
         self.rgb = rgb          # H x W x 3 uint8, downscaled
         self.points = points    # P x 2 x 2: (a, b) x (x, y), in the downscaled pixels
         self.signs = signs      # P: +1 A nearer, -1 B nearer
+        self.teacher = teacher  # H x W float32 disparity of a teacher's ensemble, or None
 
 
 def validation_photos(photo_root: Path, ordinal_file: Path = ORDINAL_FILE) -> set:
@@ -38,9 +41,11 @@ def validation_photos(photo_root: Path, ordinal_file: Path = ORDINAL_FILE) -> se
     return {(Path(photo_root) / e["photo"]).resolve() for e in entries if e["split"] in ("val", "test")}
 
 
-def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE):
-    """The photos of one split ('train', 'val' or 'test') with their ordered pairs."""
+def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE, teacher_labels=None):
+    """The photos of one split ('train', 'val' or 'test') with their ordered pairs, and
+    with teacher_labels (an `ampi distill` label folder of photo_root) each photo's label."""
     entries = json.loads(Path(ordinal_file).read_text())["photos"]
+    teacher = TeacherLabels(teacher_labels, photo_root) if teacher_labels else None
     photos = []
     for entry in entries:
         if entry["split"] != split:
@@ -58,32 +63,57 @@ def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE):
         points = np.array([[p["a"], p["b"]] for p in pairs], np.float32)
         points = (points + 0.5) * np.array([size[0] / image.width, size[1] / image.height], np.float32) - 0.5
         signs = np.array([1.0 if p["label"] == "A" else -1.0 for p in pairs], np.float32)
-        photos.append(OrdinalPhoto(rgb, points, signs))
+        photos.append(OrdinalPhoto(rgb, points, signs, teacher.of(entry["photo"], size) if teacher else None))
     if not photos:
         raise RuntimeError(f"{ordinal_file}: no labelled photos in split {split}")
     return photos
+
+
+class TeacherLabels:
+    """The labels of an `ampi distill` folder, looked up by photo name."""
+
+    def __init__(self, folder, photo_root: Path):
+        images, self.labels = distill.read_label_folder(folder)
+        if images.resolve() != Path(photo_root).resolve():
+            raise ValueError(f"{folder}: labels photos of {images}, not of {photo_root}")
+        self.folder = folder
+
+    def of(self, photo: str, size) -> np.ndarray:
+        """The label of `photo` resized to size = (w, h)."""
+        if photo not in self.labels:
+            raise ValueError(f"{self.folder}: no label for {photo} (ampi distill labels every photo of its folder)")
+        return _resize_map(distill.read_disparity(self.labels[photo]), size)
 
 
 def _resize(rgb: np.ndarray, size):
     return np.array(Image.fromarray(rgb).resize(size, Image.BILINEAR, reducing_gap=2.0))
 
 
+def _resize_map(disparity: np.ndarray, size):
+    return np.array(Image.fromarray(disparity, mode="F").resize(size, Image.BILINEAR, reducing_gap=2.0))
+
+
 def training_sample(photo: OrdinalPhoto, size, rng: random.Random):
     """A random crop (CROP_SHARE of each side), resized to size = (w, h), flipped half the
-    time: (rgb [3, h, w] float in [0, 1], points [P, 2, 2] in its pixels, signs [P]).
-    Pairs with a point outside the crop are dropped."""
+    time: (rgb [3, h, w] float in [0, 1], points [P, 2, 2] in its pixels, signs [P],
+    the teacher's label [1, h, w] cropped alike or None). Pairs with a point outside the
+    crop are dropped."""
     H, W = photo.rgb.shape[:2]
     cw, ch = round(W * rng.uniform(*CROP_SHARE)), round(H * rng.uniform(*CROP_SHARE))
     x0, y0 = rng.randint(0, W - cw), rng.randint(0, H - ch)
     rgb = _resize(photo.rgb[y0:y0 + ch, x0:x0 + cw], size)
+    teacher = None if photo.teacher is None else _resize_map(photo.teacher[y0:y0 + ch, x0:x0 + cw], size)
     points = photo.points - np.array([x0, y0], np.float32)
     keep = ((points >= -0.5) & (points <= np.array([cw, ch], np.float32) - 0.5)).all(axis=(1, 2))
     points = (points[keep] + 0.5) * np.array([size[0] / cw, size[1] / ch], np.float32) - 0.5
     if rng.random() < 0.5:
         rgb = rgb[:, ::-1]
+        teacher = None if teacher is None else teacher[:, ::-1]
         points[..., 0] = size[0] - 1 - points[..., 0]
     image = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1).float() / 255.0
-    return image, torch.from_numpy(points), torch.from_numpy(photo.signs[keep])
+    if teacher is not None:
+        teacher = torch.from_numpy(np.ascontiguousarray(teacher))[None]
+    return image, torch.from_numpy(points), torch.from_numpy(photo.signs[keep]), teacher
 
 
 def validation_sample(photo: OrdinalPhoto, long_side: int):

@@ -55,10 +55,12 @@ class Crops(unittest.TestCase):
     def test_points_follow_the_crop_resize_and_flip(self):
         rgb = coordinate_photo(320, 240)
         points = np.array([[[17.0, 33.0], [300.0, 200.0]], [[160.0, 120.0], [40.0, 220.0]]], np.float32)
-        photo = ordinal_data.OrdinalPhoto(rgb, points, np.array([1.0, -1.0], np.float32))
+        teacher = np.mgrid[0:240, 0:320][1].astype(np.float32) / 320  # a label rising to the right
+        photo = ordinal_data.OrdinalPhoto(rgb, points, np.array([1.0, -1.0], np.float32), teacher)
         for seed in range(20):
-            image, mapped, signs = ordinal_data.training_sample(photo, (64, 48), random.Random(seed))
+            image, mapped, signs, label = ordinal_data.training_sample(photo, (64, 48), random.Random(seed))
             self.assertEqual(tuple(image.shape), (3, 48, 64))
+            self.assertEqual(tuple(label.shape), (1, 48, 64))
             for pair, sign in zip(mapped, signs):
                 original = points[0] if sign > 0 else points[1]
                 for (x, y), (ox, oy) in zip(pair.tolist(), original):
@@ -66,6 +68,13 @@ class Crops(unittest.TestCase):
                     # one 64-px-wide cell is at most 8 px of the photo: within 3 of x // 4
                     self.assertLess(abs(float(pixel[0]) - ox / 4), 3.5)
                     self.assertLess(abs(float(pixel[1]) - oy / 4), 3.5)
+                    # the label is cropped, resized and flipped with the photo
+                    self.assertLess(abs(float(label[0, min(47, round(y)), min(63, round(x))]) - ox / 320), 0.03)
+
+    def test_no_teacher_no_label(self):
+        photo = ordinal_data.OrdinalPhoto(coordinate_photo(64, 48), np.zeros((0, 2, 2), np.float32),
+                                          np.zeros(0, np.float32))
+        self.assertIsNone(ordinal_data.training_sample(photo, (32, 32), random.Random(0))[3])
 
 
 class Reading(unittest.TestCase):
@@ -85,6 +94,29 @@ class Reading(unittest.TestCase):
             (root / "set.json").write_text(json.dumps({"photos": [entry]}))
             with self.assertRaisesRegex(RuntimeError, "a.png: is \\(100, 80\\), labelled at 120x80"):
                 ordinal_data.load_split("val", root, root / "set.json")
+
+
+    def test_teacher_labels_are_read_at_the_photos_size(self):
+        with tempfile.TemporaryDirectory() as folder:
+            root = Path(folder)
+            (root / "photos").mkdir()
+            Image.fromarray(coordinate_photo(100, 80)).save(root / "photos" / "a.png")
+            pairs = [{"a": [10, 70], "b": [50, 5], "label": "B"}]
+            entry = {"photo": "a.png", "width": 100, "height": 80, "split": "train", "pairs": pairs}
+            (root / "set.json").write_text(json.dumps({"photos": [entry]}))
+            labels = root / "labels"
+            labels.mkdir()
+            ramp = (np.mgrid[0:40, 0:50][0] * 1000).astype(np.uint16)  # half size, rising downwards
+            Image.fromarray(ramp).save(labels / "a.png")
+            header = f"ampi-distill\t1\nteacher\tt.ampw\tlite\tx\nresolutions\t32\nimages\t{root / 'photos'}\n"
+            (labels / "labels.tsv").write_text(header + "a.png\ta.png\n")
+            [photo] = ordinal_data.load_split("train", root / "photos", root / "set.json", labels)
+            self.assertEqual(photo.teacher.shape, (80, 100))
+            self.assertLess(float(photo.teacher[0, 0]), float(photo.teacher[79, 0]))
+            self.assertAlmostEqual(float(photo.teacher.max()), 39000 / 65535, delta=0.02)
+            (labels / "labels.tsv").write_text(header)
+            with self.assertRaisesRegex(ValueError, "no label for a.png"):
+                ordinal_data.load_split("train", root / "photos", root / "set.json", labels)
 
 
 class Labelling(unittest.TestCase):

@@ -27,6 +27,9 @@ Real photos (--ordinal training/ordinal/ordinal.json): each step also takes
 ranking loss of their labelled pairs (training/ordinal_data.py), weighted by
 --rank-weight, beside the paper's loss on the synthetic batch; every validation also
 measures WHDR on the set's validation photos, and best.pt is then the best WHDR.
+--teacher-labels LABELS (an `ampi distill` folder of the photo folder) adds the paper's
+loss on those photos' pseudo ground truth, cropped and flipped with them and weighted by
+--teacher-weight: the paper's self-distillation, beside the scenes and the pairs.
 Batches are made ahead by --workers processes (DataLoader), so the network never waits
 for the scene renderer.
 """
@@ -46,6 +49,7 @@ import torch.nn.functional as F
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import depth_model  # noqa: E402
+import distill  # noqa: E402
 import losses  # noqa: E402
 import ordinal_data  # noqa: E402
 
@@ -121,22 +125,15 @@ class PairFolderSource:
     @classmethod
     def from_labels(cls, folder: str, size, held_out: set):
         """An `ampi distill` label folder; photos in `held_out` (resolved paths) are left out."""
-        lines = (Path(folder) / "labels.tsv").read_text().splitlines()
-        if not lines or lines[0] != "ampi-distill\t1":
-            raise ValueError(f"{folder}/labels.tsv: not a label folder of ampi distill")
-        header = dict(line.split("\t", 1) for line in lines[1:4])
-        images = Path(header["images"])
-        pairs = []
-        for line in lines[4:]:
-            label, photo = line.split("\t")
-            if (images / photo).resolve() not in held_out:
-                pairs.append((images / photo, Path(folder) / label))
+        images, labels = distill.read_label_folder(folder)
+        pairs = [(images / photo, label) for photo, label in labels.items()
+                 if (images / photo).resolve() not in held_out]
         return cls(pairs, size, folder)
 
     def _load(self, pair):
         from PIL import Image, ImageOps  # Debian's python3-pil
         image = ImageOps.exif_transpose(Image.open(pair[0])).convert("RGB")
-        disparity = read_disparity(pair[1])
+        disparity = distill.read_disparity(pair[1])
         if disparity.shape != (image.height, image.width):
             raise ValueError(f"{pair[1]}: {disparity.shape[1]}x{disparity.shape[0]}, "
                              f"its photo {pair[0]} is {image.width}x{image.height}")
@@ -152,15 +149,6 @@ class PairFolderSource:
 
     def validation_count(self, wanted: int) -> int:
         return min(wanted, len(self.val))
-
-
-def read_disparity(path: Path) -> np.ndarray:
-    """A float32 H x W disparity from NAME.npy or a 16-bit PNG (scaled to [0, 1])."""
-    if path.suffix == ".npy":
-        return np.load(path).astype(np.float32)
-    from PIL import Image
-    with Image.open(path) as image:
-        return np.asarray(image, dtype=np.float32) / 65535.0
 
 
 def make_source(spec: str, size, held_out: set = frozenset()):
@@ -213,12 +201,15 @@ class TrainingBatches(torch.utils.data.Dataset):
         return rgb, disp, list(steps), real
 
     def real_photos(self, rng: random.Random):
+        """(photos [N, 3, h, w], N (points, signs) tuples, the teacher's labels [N, 1, h, w]
+        or None)."""
         if not self.ordinal_photos:
-            return None, []
+            return None, [], None
         samples = [ordinal_data.training_sample(rng.choice(self.ordinal_photos), self.size, rng)
                    for _ in range(self.args.ordinal_batch)]
         real = torch.stack([s[0] for s in samples]).contiguous(memory_format=torch.channels_last)
-        return real, [(s[1], s[2]) for s in samples]
+        teacher = torch.stack([s[3] for s in samples]) if samples[0][3] is not None else None
+        return real, [(s[1], s[2]) for s in samples], teacher
 
 
 def scene_view(rgb, disp, step: int, args):
@@ -384,10 +375,11 @@ def follow_schedule(optimiser, args, step: int):
 
 
 def training_step(model, optimiser, batch, args):
-    """One Adam step on a batch of TrainingBatches: (loss, its parts, ranking loss)."""
-    rgb, disp, real_rgb, pairs = batch
+    """One Adam step on a batch of TrainingBatches: (loss, its parts, ranking loss, loss on
+    the teacher's labels)."""
+    rgb, disp, real_rgb, pairs, real_teacher = batch
     rgb, disp = rgb.to(args.device, non_blocking=True), disp.to(args.device, non_blocking=True)
-    rank = torch.zeros(())
+    rank = taught = torch.zeros(())
     if real_rgb is None:
         loss, parts = losses.depth_loss(model(rgb), disp)
     else:  # one pass over both: the BatchNorms see real photos too
@@ -397,10 +389,13 @@ def training_step(model, optimiser, batch, args):
         loss, parts = losses.depth_loss([o[:len(rgb)] for o in outputs], disp)
         rank = ordinal_data.ranking_loss(outputs[-1][len(rgb):], pairs)
         loss = loss + args.rank_weight * rank
+        if real_teacher is not None:  # the paper's loss on the real photos' pseudo ground truth
+            taught, _ = losses.depth_loss([o[len(rgb):] for o in outputs], real_teacher.to(args.device))
+            loss = loss + args.teacher_weight * taught
     optimiser.zero_grad(set_to_none=True)
     loss.backward()
     optimiser.step()
-    return loss, parts, rank
+    return loss, parts, rank, taught
 
 
 class WeightAverage:
@@ -459,7 +454,8 @@ def train(args):
     source = make_source(args.data, size, held_out)
     ordinal_train = ordinal_val = None
     if args.ordinal:
-        ordinal_train = ordinal_data.load_split("train", photo_folder.photo_root(), args.ordinal)
+        ordinal_train = ordinal_data.load_split("train", photo_folder.photo_root(), args.ordinal,
+                                                args.teacher_labels)
         ordinal_val = ordinal_data.load_split("val", photo_folder.photo_root(), args.ordinal)
     best_of = "ordinal_whdr" if ordinal_val else "val_loss"  # what best.pt keeps the lowest of
     ckpt_path = run / "checkpoint.pt"
@@ -480,7 +476,8 @@ def train(args):
         log_line(run, f"initialised {args.model} from {args.init}")
     follow_schedule(optimiser, args, step)
     val_count = source.validation_count(args.val_count)
-    real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g})"
+    taught = f", teacher's labels {args.teacher_labels} weight {args.teacher_weight:g}" if args.teacher_labels else ""
+    real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g}{taught})"
             if ordinal_train else "")
     ema = f", weights averaged (decay {args.ema:g})" if average else ""
     decay = (f" (cosine decay from {args.lr:.2e} to {args.lr * LR_FLOOR:.2e} at step {args.decay_steps})"
@@ -520,10 +517,10 @@ def train(args):
     for rgb, disp, steps, real in batches:
         rgb = rgb.to(args.device, non_blocking=True)
         disp = disp.to(args.device, non_blocking=True)
-        for step_of_batch, (real_rgb, pairs) in zip(steps, real):
+        for step_of_batch, (real_rgb, pairs, real_teacher) in zip(steps, real):
             follow_schedule(optimiser, args, step)
-            loss, parts, rank = training_step(model, optimiser,
-                                              (*scene_view(rgb, disp, step_of_batch, args), real_rgb, pairs), args)
+            loss, parts, rank, taught = training_step(
+                model, optimiser, (*scene_view(rgb, disp, step_of_batch, args), real_rgb, pairs, real_teacher), args)
             if average:
                 average.update(model)
             step += 1
@@ -533,7 +530,7 @@ def train(args):
                 timed_from = trained_until  # the rate leaves out start-up and the first step
             if step % args.log_every == 0:
                 log_line(run, f"step {step} loss {float(loss):.4f} data {parts['data']:.4f} grad {parts['grad']:.4f} "
-                              f"rank {float(rank):.4f} lr {optimiser.param_groups[0]['lr']:.2e} "
+                              f"rank {float(rank):.4f}{f' teacher {float(taught):.4f}' if args.teacher_labels else ''} lr {optimiser.param_groups[0]['lr']:.2e} "
                               f"{(time.time() - t0) / seen:.2f} s/step")
             out_of_time = args.minutes > 0 and time.time() - t0 >= 60 * args.minutes
             if step % args.val_every == 0 or step == args.steps or out_of_time:
@@ -584,10 +581,15 @@ def main(argv=None):
                                      "training photos, WHDR on its validation photos")
     p.add_argument("--ordinal-batch", type=int, default=4, help="real photos per step with --ordinal")
     p.add_argument("--rank-weight", type=float, default=1.0, help="weight of the ranking loss")
+    p.add_argument("--teacher-labels", help="an `ampi distill` label folder of the photo folder: the paper's "
+                                            "loss on the --ordinal training photos' labels too (self-distillation)")
+    p.add_argument("--teacher-weight", type=float, default=1.0, help="weight of the loss on --teacher-labels")
     p.add_argument("--ema", type=float, default=0.0,
                    help="validate and keep an exponential moving average of the weights with this decay "
                         "(e.g. 0.999; 0: the weights as trained)")
     args = p.parse_args(argv)
+    if args.teacher_labels and not args.ordinal:
+        raise SystemExit("train_depth.py: --teacher-labels labels the --ordinal training photos; give --ordinal")
     if args.lr_decay == "cosine" and args.decay_steps <= 0:
         raise SystemExit("train_depth.py: --lr-decay cosine needs --decay-steps N (N > 0)")
     return train(args)

@@ -2,7 +2,8 @@
 # ampi distill end to end with a random-weight teacher (tests/fixtures/nets/tiny_depth.ampw):
 # one 16-bit label per photo at the photo's size, the manifest, resumption (a photo added
 # later is the only one labelled next time), refusals that leave everything as it was,
-# and training/train_depth.py taking the folder as --data distilled:LABELS.
+# and training/train_depth.py taking the folder as --data distilled:LABELS and as
+# --teacher-labels LABELS beside an ordinal set.
 #   usage: distill_cli.sh AMPI_BINARY SOURCE_DIR
 set -u
 ampi=$1
@@ -53,6 +54,12 @@ grep -q "3 photos labelled (2 by earlier runs)" "$tmp/log" || fail "second run: 
 [ "$(png_header "$tmp/dav2/sub_b.png")" = "45 61 16 0" ] || fail "dav2 sub_b.png: header $(png_header "$tmp/dav2/sub_b.png")"
 grep -q "^resolutions	28,42$" "$tmp/dav2/labels.tsv" || fail "dav2 labels.tsv lacks the resolutions"
 
+# With the aspect kept the labels are still at each photo's size, and the header says so.
+distill --resolutions 32,48 --keep-aspect -o "$tmp/aspect" >"$tmp/log" 2>&1 || fail "--keep-aspect: $(cat "$tmp/log")"
+[ "$(png_header "$tmp/aspect/sub_b.png")" = "45 61 16 0" ] || fail "aspect sub_b.png: header $(png_header "$tmp/aspect/sub_b.png")"
+grep -q "^resolutions	32,48	aspect kept$" "$tmp/aspect/labels.tsv" || fail "aspect labels.tsv: $(sed -n 3p "$tmp/aspect/labels.tsv")"
+cmp -s "$tmp/aspect/a.png" "$tmp/labels/a.png" && fail "--keep-aspect made the squares' label"
+
 # Refusals: one line, non-zero exit, the folder unchanged.
 before=$(ls -l "$tmp/labels" | md5sum)
 expect_error() {
@@ -65,6 +72,7 @@ expect_error() {
   fi
 }
 expect_error "this run asks for 'resolutions	32'" distill --resolutions 32
+expect_error "this run asks for 'resolutions	32,48	aspect kept'" distill --resolutions 32,48 --keep-aspect
 expect_error "'x' is not a side" distill --resolutions 32,x
 expect_error "missing --teacher" "$ampi" distill --images "$tmp/photos" -o "$tmp/labels"
 mkdir "$tmp/mine" && echo keep >"$tmp/mine/notes.txt"
@@ -77,6 +85,20 @@ expect_error "not empty and not made by ampi distill" "$ampi" distill --teacher 
   --size 64x64 --batch 2 --steps 2 --val-every 2 --val-count 1 --workers 0 >"$tmp/train.log" 2>&1 \
   || fail "train_depth.py on the labels: $(tail -5 "$tmp/train.log")"
 [ -f "$tmp/run/checkpoint.pt" ] || fail "train_depth.py wrote no checkpoint"
+
+# Or as the ordinal training photos' pseudo ground truth, beside their pairs.
+cat >"$tmp/ordinal.json" <<'JSON'
+{"photos": [
+ {"photo": "a.jpg", "width": 70, "height": 50, "split": "train", "pairs": [{"a": [5, 5], "b": [60, 40], "label": "B"}]},
+ {"photo": "sub/b.png", "width": 45, "height": 61, "split": "train", "pairs": [{"a": [5, 50], "b": [40, 5], "label": "A"}]},
+ {"photo": "c.jpg", "width": 64, "height": 64, "split": "val", "pairs": [{"a": [3, 60], "b": [60, 3], "label": "A"}]}]}
+JSON
+AMPI_PHOTO_ROOT="$tmp/photos" /usr/bin/python3 "$src/training/train_depth.py" --model lite --run "$tmp/taught" \
+  --data cards --size 64x64 --batch 1 --steps 2 --val-every 2 --val-count 1 --workers 0 --log-every 1 \
+  --ordinal "$tmp/ordinal.json" --ordinal-batch 2 --teacher-labels "$tmp/labels" >"$tmp/train.log" 2>&1 \
+  || fail "train_depth.py with --teacher-labels: $(tail -5 "$tmp/train.log")"
+grep -q "step 2 loss .* rank .* teacher [0-9]" "$tmp/taught/train.log" \
+  || fail "no loss on the teacher's labels in the log: $(tail -3 "$tmp/taught/train.log")"
 
 [ "$failures" = 0 ] && echo "distill_cli: all checks passed"
 exit "$failures"

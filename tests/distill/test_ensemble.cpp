@@ -51,7 +51,7 @@ std::string error_of(const std::function<void()>& f) {
 }
 
 LabelRecipe recipe(const std::string& teacher_file = "teacher.ampw") {
-  return {teacher_file, "ampi.depth.dwt-mobilenetv3", "lite", {16, 24}, "/photos"};
+  return {teacher_file, "ampi.depth.dwt-mobilenetv3", "lite", {16, 24}, EnsembleShape::kSquare, "/photos"};
 }
 
 }  // namespace
@@ -62,6 +62,23 @@ TEST_CASE("the ensemble equals training/distill.py on the fixture") {
   const cv::Mat label = pseudo_ground_truth(rgb, analytic_teacher, {16, 24, 40});
   REQUIRE(label.size() == expected.size());
   CHECK(cv::norm(label, expected, cv::NORM_INF) < 1e-4);
+}
+
+TEST_CASE("the ensemble with the aspect kept equals training/distill.py on the fixture") {
+  const cv::Mat rgb = read_npy_mat(kFixtures + "rgb.npy");
+  const cv::Mat expected = read_npy_mat(kFixtures + "label_aspect.npy");
+  const cv::Mat label = pseudo_ground_truth(rgb, analytic_teacher, {16, 24, 40}, EnsembleShape::kAspectKept);
+  REQUIRE(label.size() == expected.size());
+  CHECK(cv::norm(label, expected, cv::NORM_INF) < 1e-4);
+  CHECK(cv::norm(label, read_npy_mat(kFixtures + "label.npy"), cv::NORM_INF) > 1e-3);  // not the squares'
+}
+
+TEST_CASE("ensemble sizes: squares, or long sides with the aspect kept") {
+  const std::vector<cv::Size> squares = ensemble_sizes({300, 200}, {16, 64}, EnsembleShape::kSquare);
+  CHECK(squares == std::vector<cv::Size>{{16, 16}, {64, 64}});
+  const std::vector<cv::Size> kept = ensemble_sizes({300, 200}, {30, 256}, EnsembleShape::kAspectKept);
+  CHECK(kept == std::vector<cv::Size>{{30, 20}, {256, 171}});
+  CHECK(ensemble_sizes({200, 300}, {30}, EnsembleShape::kAspectKept) == std::vector<cv::Size>{{20, 30}});
 }
 
 TEST_CASE("a mirrored prediction is flipped back before the median") {
