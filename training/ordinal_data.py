@@ -157,3 +157,31 @@ def whdr_counts(disparity: torch.Tensor, points: torch.Tensor, signs: torch.Tens
     predicted = torch.sign(values[:, 0] - values[:, 1])
     wrong = torch.where(predicted == 0, torch.full_like(signs, 0.5), (predicted != signs).float())
     return float(wrong.sum()), int(len(signs))
+
+
+def labels_whdr(labels, split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE):
+    """(WHDR, ordered pairs) of an `ampi distill` label folder's labels on one split: how
+    well a teacher's ensemble orders the pairs before any network learns from it."""
+    wrong, pairs = 0.0, 0
+    for photo in load_split(split, photo_root, ordinal_file, labels):
+        photo_wrong, photo_pairs = whdr_counts(torch.from_numpy(photo.teacher)[None],
+                                               torch.from_numpy(photo.points), torch.from_numpy(photo.signs))
+        wrong, pairs = wrong + photo_wrong, pairs + photo_pairs
+    return wrong / max(pairs, 1), pairs
+
+
+def main(argv=None):
+    import argparse
+    import photo_folder
+    p = argparse.ArgumentParser(description="WHDR of an `ampi distill` label folder on the ordinal set: "
+                                            "/usr/bin/python3 training/ordinal_data.py LABELS [--split test]")
+    p.add_argument("labels", help="an ampi distill label folder of the photo folder")
+    p.add_argument("--split", default="val", choices=("train", "val", "test"))
+    p.add_argument("--ordinal", default=str(ORDINAL_FILE))
+    args = p.parse_args(argv)
+    whdr, pairs = labels_whdr(args.labels, args.split, photo_folder.photo_root(), args.ordinal)
+    print(f"{args.labels}: WHDR {whdr:.4f} on {pairs} ordered pairs of {args.split}")
+
+
+if __name__ == "__main__":
+    main()

@@ -114,6 +114,8 @@ class Reading(unittest.TestCase):
             self.assertEqual(photo.teacher.shape, (80, 100))
             self.assertLess(float(photo.teacher[0, 0]), float(photo.teacher[79, 0]))
             self.assertAlmostEqual(float(photo.teacher.max()), 39000 / 65535, delta=0.02)
+            # the label puts A (lower in the photo) nearer; the pair says B: all wrong
+            self.assertEqual(ordinal_data.labels_whdr(labels, "train", root / "photos", root / "set.json"), (1.0, 1))
             (labels / "labels.tsv").write_text(header)
             with self.assertRaisesRegex(ValueError, "no label for a.png"):
                 ordinal_data.load_split("train", root / "photos", root / "set.json", labels)
