@@ -133,21 +133,25 @@ def pack_photos(out: Path):
         small = image.resize((round(image.width * scale), round(image.height * scale)), Image.LANCZOS)
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)
-        small.save(target, format="JPEG", quality=85)  # keeps the name, and so the split
+        small.save(target, format="JPEG", quality=75)  # keeps the name, and so the split
         sizes[rel] = (small.width / image.width, small.height / image.height, small.width, small.height)
     return sizes
 
 
 def scaled_ordinal_set(ordinal: Path, sizes) -> dict:
+    """The ordinal set for the carried photos: its points scaled to their sizes, and only
+    what training reads (the ordered pairs' points and labels), which is a third of the
+    file: every MiB counts against the transfer limit."""
     data = json.loads(Path(ordinal).read_text())
+    photos = []
     for entry in data["photos"]:
         sx, sy, w, h = sizes[entry["photo"]]
-        entry["width"], entry["height"] = w, h
-        for pair in entry["pairs"]:
-            for key in ("a", "b"):
-                x, y = pair[key]
-                pair[key] = [min((x + 0.5) * sx - 0.5, w - 1), min((y + 0.5) * sy - 0.5, h - 1)]
-    return data
+        pairs = [{"label": pair["label"],
+                  **{key: [round(min((pair[key][0] + 0.5) * sx - 0.5, w - 1), 2),
+                           round(min((pair[key][1] + 0.5) * sy - 0.5, h - 1), 2)] for key in ("a", "b")}}
+                 for pair in entry["pairs"] if pair["label"] in ("A", "B")]
+        photos.append({**entry, "width": w, "height": h, "pairs": pairs})
+    return {"photos": photos}
 
 
 def pack_planes(out: Path, sizes, disparity_dir: str) -> int:

@@ -42,7 +42,8 @@ def make_photos(root: Path):
         Image.fromarray(rng.integers(0, 255, (300, 900, 3), dtype=np.uint8)).save(root / "photos" / "set" / name)
         entries.append({"photo": f"set/{name}", "width": 900, "height": 300,
                         "split": "val" if i % 5 == 4 else "train",
-                        "pairs": [{"a": [10.0, 290.0], "b": [899.0, 0.0], "label": "A"}]})
+                        "pairs": [{"a": [10.0, 290.0], "b": [899.0, 0.0], "label": "A", "votes": "AA"},
+                                  {"a": [20.0, 20.0], "b": [30.0, 30.0], "label": "=", "votes": "A="}]})
     (root / "ordinal.json").write_text(json.dumps({"photos": entries}))
 
 
@@ -88,6 +89,12 @@ class RoundTrip(unittest.TestCase):
                 with Image.open(carry / "photos" / "set" / "p0.jpg") as photo:
                     self.assertEqual(photo.size, (384, 128))
                 self.assertLess(packed["pairs"][0]["b"][0], 384)
+                # only the ordered pair, its label and its points (pixel centres scaled, kept inside)
+                [pair] = packed["pairs"]
+                self.assertEqual(set(pair), {"label", "a", "b"})
+                scale = 384 / 900
+                self.assertEqual(pair["a"], [round(10.5 * scale - 0.5, 2), round(290.5 * scale - 0.5, 2)])
+                self.assertEqual(pair["b"], [383, round(0.5 * scale - 0.5, 2)])
                 self.check_plane_map(carry, tmp / "disparity")
                 self.assertIn("--lr-decay cosine --decay-steps 1000", (carry / "train.sh").read_text())
                 command = printed.strip().splitlines()[-1]
