@@ -1,8 +1,9 @@
 // The paper's pseudo ground truth for distillation: a teacher's 10x ensemble on one photo.
 //
 // The teacher runs at several resolutions (squares, or long sides with the aspect kept)
-// on the photo and on its mirror image (the mirrored prediction flipped back). Each prediction is normalised on its own by
-// its median and mean absolute deviation, d' = (d - median) / MAD (MiDaS' scale-and-shift
+// on the photo and on its mirror image (the mirrored prediction flipped back). Each
+// prediction is normalised on its own by its median and mean absolute deviation,
+// d' = (d - median) / MAD (MiDaS' scale-and-shift
 // alignment: a teacher's disparity scale drifts with the input size, and one extreme
 // pixel cannot throw it off as it would min-max), resized bilinearly to the largest
 // size, and the per-pixel median of all of them is the label; it is finally resized to

@@ -96,21 +96,22 @@ def pseudo_ground_truth(rgb: np.ndarray, teacher: Teacher,
     return ((d - lo) / max(hi - lo, 1e-8)).astype(np.float32)
 
 
-def network_teacher(checkpoint: str, model_name: str = "heavy", multiple: int = 32) -> Teacher:
-    """Our own trained network as a teacher (self-distillation: heavy labels photos for lite).
-    Every paper resolution is a multiple of 32, so the squares need no padding."""
+def network_teacher(checkpoint: str, model_name: str = "heavy") -> Teacher:
+    """Our own trained network as a teacher (self-distillation). An input whose sides are
+    not multiples of the network's is edge-replicated up to them and the output cropped
+    back, as the engine runs it (the paper's squares are multiples of 32 already)."""
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     import depth_model
     model = depth_model.build(model_name)
     model.load_state_dict(torch.load(checkpoint, map_location="cpu")["model"])
     model.eval()
 
+    @torch.no_grad()
     def teacher(rgb: np.ndarray) -> np.ndarray:
         h, w = rgb.shape[:2]
-        if h % multiple or w % multiple:
-            raise ValueError(f"teacher input {h}x{w} is not a multiple of {multiple}")
         x = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1)[None]
-        return model.predict(x.contiguous(memory_format=torch.channels_last))[0, 0].numpy()
+        x = F.pad(x, (0, (-w) % model.multiple, 0, (-h) % model.multiple), mode="replicate")
+        return model.predict(x.contiguous(memory_format=torch.channels_last))[0, 0, :h, :w].numpy()
 
     return teacher
 
@@ -138,7 +139,7 @@ def read_disparity(path: Path) -> np.ndarray:
         return np.asarray(image, dtype=np.float32) / 65535.0
 
 
-def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequence[int]):
+def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequence[int], keep_aspect: bool = False):
     from PIL import Image, ImageOps  # Debian's python3-pil
     out.mkdir(parents=True, exist_ok=True)
     names = sorted(p for p in photos.rglob("*") if p.suffix.lower() in (".jpg", ".jpeg", ".png"))
@@ -149,12 +150,12 @@ def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequenc
             continue  # resumable: finished photos are kept
         image = ImageOps.exif_transpose(Image.open(path)).convert("RGB")
         full_size = image.size
-        # area-averaged down to the largest square first, as `ampi distill` does: the
-        # bilinear squares would alias a large photo
+        # area-averaged down to the largest side first, as `ampi distill` does: the
+        # bilinear resizes would alias a large photo
         scale = max(resolutions) / max(full_size)
         if scale < 1:
             image = image.resize((max(1, round(image.width * scale)), max(1, round(image.height * scale))), Image.BOX)
-        label = pseudo_ground_truth(np.asarray(image, dtype=np.float32) / 255.0, teacher, resolutions)
+        label = pseudo_ground_truth(np.asarray(image, dtype=np.float32) / 255.0, teacher, resolutions, keep_aspect)
         np.save(target, resize_bilinear(label, full_size[1], full_size[0]))
         link = out / f"{stem}{path.suffix.lower()}"
         if not link.exists():
@@ -170,12 +171,14 @@ def main(argv=None):
     p.add_argument("--teacher-model", default="heavy")
     p.add_argument("--resolutions", default=",".join(map(str, PAPER_RESOLUTIONS)),
                    help="comma-separated square sides")
+    p.add_argument("--keep-aspect", action="store_true",
+                   help="the resolutions are long sides, the photo's aspect kept (as ampi distill --keep-aspect)")
     p.add_argument("--threads", type=int, default=1)
     args = p.parse_args(argv)
     torch.set_num_threads(args.threads)
     resolutions = [int(v) for v in args.resolutions.split(",")]
     label_folder(Path(args.photos), Path(args.out),
-                 network_teacher(args.teacher_checkpoint, args.teacher_model), resolutions)
+                 network_teacher(args.teacher_checkpoint, args.teacher_model), resolutions, args.keep_aspect)
 
 
 if __name__ == "__main__":
