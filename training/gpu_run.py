@@ -146,9 +146,12 @@ def scaled_ordinal_set(ordinal: Path, sizes) -> dict:
     photos = []
     for entry in data["photos"]:
         sx, sy, w, h = sizes[entry["photo"]]
-        pairs = [{"label": pair["label"],
-                  **{key: [round(min((pair[key][0] + 0.5) * sx - 0.5, w - 1), 2),
-                           round(min((pair[key][1] + 0.5) * sy - 0.5, h - 1), 2)] for key in ("a", "b")}}
+
+        def scaled(point):  # pixel centres scaled, kept inside the carried photo
+            x, y = point
+            return [round(min((x + 0.5) * sx - 0.5, w - 1), 2), round(min((y + 0.5) * sy - 0.5, h - 1), 2)]
+
+        pairs = [{"label": pair["label"], "a": scaled(pair["a"]), "b": scaled(pair["b"])}
                  for pair in entry["pairs"] if pair["label"] in ("A", "B")]
         photos.append({**entry, "width": w, "height": h, "pairs": pairs})
     return {"photos": photos}

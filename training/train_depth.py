@@ -476,8 +476,10 @@ def train(args):
         log_line(run, f"initialised {args.model} from {args.init}")
     follow_schedule(optimiser, args, step)
     val_count = source.validation_count(args.val_count)
-    taught = f", teacher's labels {args.teacher_labels} weight {args.teacher_weight:g}" if args.teacher_labels else ""
-    real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g}{taught})"
+    teacher_note = (f", teacher's labels {args.teacher_labels} weight {args.teacher_weight:g}"
+                    if args.teacher_labels else "")
+    real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g}"
+            f"{teacher_note})"
             if ordinal_train else "")
     ema = f", weights averaged (decay {args.ema:g})" if average else ""
     decay = (f" (cosine decay from {args.lr:.2e} to {args.lr * LR_FLOOR:.2e} at step {args.decay_steps})"
