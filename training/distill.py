@@ -20,7 +20,9 @@ to the square it was given. See training/README.md for plugging in MiDaS.
     /usr/bin/python3 training/distill.py --photos DIR --out DIR --teacher-checkpoint RUN/checkpoint.pt
 
 writes OUT/NAME.jpg (the photo, a symlink) and OUT/NAME.npy (float32 disparity in [0, 1]),
-the `pairs:OUT` data source of train_depth.py.
+the `pairs:OUT` data source of train_depth.py, and OUT/labels.tsv as `ampi distill` writes
+it, so OUT also serves train_depth.py --teacher-labels (gpu_run.py makes its teacher's
+labels this way on the GPU machine, where the engine is not built).
 """
 from __future__ import annotations
 
@@ -32,6 +34,8 @@ from typing import Callable, Sequence
 import numpy as np
 import torch
 import torch.nn.functional as F
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))   # depth_model, export_depth, ampw
 
 PAPER_RESOLUTIONS = (512, 768, 1024, 1600, 1920)
 
@@ -96,22 +100,27 @@ def pseudo_ground_truth(rgb: np.ndarray, teacher: Teacher,
     return ((d - lo) / max(hi - lo, 1e-8)).astype(np.float32)
 
 
-def network_teacher(checkpoint: str, model_name: str = "heavy") -> Teacher:
-    """Our own trained network as a teacher (self-distillation). An input whose sides are
-    not multiples of the network's is edge-replicated up to them and the output cropped
-    back, as the engine runs it (the paper's squares are multiples of 32 already)."""
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
+def network_teacher(weights: str, model_name: str = "heavy", device: str = "cpu") -> Teacher:
+    """Our own trained network as a teacher (self-distillation): a train_depth.py
+    checkpoint of `model_name`, or an exported .ampw (whose architecture it names). An
+    input whose sides are not multiples of the network's is edge-replicated up to them and
+    the output cropped back, as the engine runs it (the paper's squares are multiples of
+    32 already)."""
     import depth_model
-    model = depth_model.build(model_name)
-    model.load_state_dict(torch.load(checkpoint, map_location="cpu")["model"])
-    model.eval()
+    if weights.endswith(".ampw"):
+        import export_depth
+        model = export_depth.import_ampw(weights)
+    else:
+        model = depth_model.build(model_name)
+        model.load_state_dict(torch.load(weights, map_location="cpu")["model"])
+    model = model.to(device).eval()
 
     @torch.no_grad()
     def teacher(rgb: np.ndarray) -> np.ndarray:
         h, w = rgb.shape[:2]
-        x = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1)[None]
+        x = torch.from_numpy(np.ascontiguousarray(rgb)).permute(2, 0, 1)[None].to(device)
         x = F.pad(x, (0, (-w) % model.multiple, 0, (-h) % model.multiple), mode="replicate")
-        return model.predict(x.contiguous(memory_format=torch.channels_last))[0, 0, :h, :w].numpy()
+        return model.predict(x.contiguous(memory_format=torch.channels_last))[0, 0, :h, :w].cpu().numpy()
 
     return teacher
 
@@ -139,15 +148,53 @@ def read_disparity(path: Path) -> np.ndarray:
         return np.asarray(image, dtype=np.float32) / 65535.0
 
 
-def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequence[int], keep_aspect: bool = False):
+def teacher_line(weights: str, model_name: str) -> str:
+    """labels.tsv's teacher line, as `ampi distill` writes it: file name, architecture,
+    variant (a checkpoint's architecture is train_depth.py's)."""
+    if weights.endswith(".ampw"):
+        from ampw import read_ampw
+        meta, _ = read_ampw(weights)
+        return f"teacher\t{Path(weights).name}\t{meta['arch']}\t{meta['depth.variant']}"
+    return f"teacher\t{Path(weights).name}\ttrain_depth.py checkpoint\t{model_name}"
+
+
+def open_manifest(out: Path, header: list[str]) -> set:
+    """OUT/labels.tsv with `header`, created or reopened; the photos it already lists.
+    As `ampi distill` (distill/label_folder.h): a folder made with another teacher,
+    other resolutions or another photo folder is refused, and so is a non-empty folder
+    without labels.tsv."""
+    manifest = out / "labels.tsv"
+    if not manifest.exists():
+        if out.exists() and any(out.iterdir()):
+            raise SystemExit(f"{out}: not empty and has no labels.tsv; give a new folder")
+        out.mkdir(parents=True, exist_ok=True)
+        manifest.write_text("\n".join(header) + "\n")
+        return set()
+    lines = manifest.read_text().splitlines()
+    if lines[:len(header)] != header:
+        raise SystemExit(f"{manifest}: made with another teacher, resolutions or photo folder "
+                         f"({' | '.join(lines[1:len(header)])})")
+    return {line.split("\t")[1] for line in lines[len(header):]}
+
+
+def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequence[int], keep_aspect: bool = False,
+                 teacher_name: str = "teacher\tunnamed\t-\t-"):
+    """Labels every photo under `photos` into OUT: NAME.npy (float32 disparity in [0, 1]
+    at the photo's size), a link NAME.jpg|png to the photo (the `pairs:OUT` source), and
+    a line in OUT/labels.tsv, `ampi distill`'s format, so that OUT is also a folder for
+    train_depth.py --teacher-labels and --data distilled:OUT. Resumable: a photo is
+    listed once its label is written, and listed photos are skipped."""
     from PIL import Image, ImageOps  # Debian's python3-pil
-    out.mkdir(parents=True, exist_ok=True)
+    header = ["ampi-distill\t1", teacher_name,
+              f"resolutions\t{','.join(map(str, resolutions))}" + ("\taspect kept" if keep_aspect else ""),
+              f"images\t{photos.resolve()}"]
+    done = open_manifest(out, header)
     names = sorted(p for p in photos.rglob("*") if p.suffix.lower() in (".jpg", ".jpeg", ".png"))
     for i, path in enumerate(names):
+        rel = path.relative_to(photos).as_posix()
+        if rel in done:
+            continue
         stem = "_".join(path.relative_to(photos).with_suffix("").parts)
-        target = out / f"{stem}.npy"
-        if target.exists():
-            continue  # resumable: finished photos are kept
         image = ImageOps.exif_transpose(Image.open(path)).convert("RGB")
         full_size = image.size
         # area-averaged down to the largest side first, as `ampi distill` does: the
@@ -156,29 +203,34 @@ def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequenc
         if scale < 1:
             image = image.resize((max(1, round(image.width * scale)), max(1, round(image.height * scale))), Image.BOX)
         label = pseudo_ground_truth(np.asarray(image, dtype=np.float32) / 255.0, teacher, resolutions, keep_aspect)
-        np.save(target, resize_bilinear(label, full_size[1], full_size[0]))
+        np.save(out / f"{stem}.npy", resize_bilinear(label, full_size[1], full_size[0]))
         link = out / f"{stem}{path.suffix.lower()}"
         if not link.exists():
             link.symlink_to(path.resolve())
-        print(f"[{i + 1}/{len(names)}] {path} -> {target}", flush=True)
+        with open(out / "labels.tsv", "a") as manifest:
+            manifest.write(f"{stem}.npy\t{rel}\n")
+        print(f"[{i + 1}/{len(names)}] {path} -> {out / stem}.npy", flush=True)
 
 
 def main(argv=None):
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--photos", required=True, help="folder of photos (searched recursively)")
     p.add_argument("--out", required=True, help="output folder: NAME.npy pseudo-labels + photo links")
-    p.add_argument("--teacher-checkpoint", required=True, help="train_depth.py checkpoint.pt of the teacher")
-    p.add_argument("--teacher-model", default="heavy")
+    p.add_argument("--teacher-checkpoint", required=True,
+                   help="the teacher: a train_depth.py checkpoint.pt (of --teacher-model) or an exported .ampw")
+    p.add_argument("--teacher-model", default="heavy", help="the checkpoint's architecture (an .ampw names its own)")
     p.add_argument("--resolutions", default=",".join(map(str, PAPER_RESOLUTIONS)),
                    help="comma-separated square sides")
     p.add_argument("--keep-aspect", action="store_true",
                    help="the resolutions are long sides, the photo's aspect kept (as ampi distill --keep-aspect)")
     p.add_argument("--threads", type=int, default=1)
+    p.add_argument("--device", default="cpu", help="where the teacher runs (cuda on a GPU machine)")
     args = p.parse_args(argv)
     torch.set_num_threads(args.threads)
     resolutions = [int(v) for v in args.resolutions.split(",")]
     label_folder(Path(args.photos), Path(args.out),
-                 network_teacher(args.teacher_checkpoint, args.teacher_model), resolutions, args.keep_aspect)
+                 network_teacher(args.teacher_checkpoint, args.teacher_model, args.device), resolutions,
+                 args.keep_aspect, teacher_line(args.teacher_checkpoint, args.teacher_model))
 
 
 if __name__ == "__main__":

@@ -21,6 +21,12 @@ size (inpaint_data.write_planes; the maps themselves would not fit); the others 
 stand-in there as here. `pack` prints what each part of the transfer takes and fails,
 naming them, when the working tree and carry/ come to more than 64 MiB.
 
+With --teacher WEIGHTS.ampw the depth runs self-distil as they do here (train_depth.py
+--teacher-labels). The labels would not fit the transfer, so the GPU machine makes them
+before training: the teacher's ensemble at long sides 192-320 of the carried photos
+(distill.py --keep-aspect, on the GPU). Here `ampi distill` labels the full-size photos,
+area-shrunk to 320 px, so the two label sets differ by what the 384-px JPEG loses.
+
 The runs train side by side on the one GPU, the machine's cores shared out equally among
 their DataLoader workers (scenes for depth, crops and their prefill for inpainting); the
 GPU outruns the scene renderer, so each depth scene batch trains --scene-reuse steps
@@ -61,6 +67,7 @@ PHOTO_LONG_SIDE = 384
 TRANSFER_LIMIT = 64 * 2 ** 20   # the device tool's working tree, carried folder included
 ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
 INPAINT = "inpaint"
+TEACHER_LABELS = "teacher"   # the teacher's label folder under the carried folder, made there
 NETWORKS = (*depth_model.ARCHITECTURES, INPAINT)   # what --run NAME:DIR may name
 INPAINT_ARGS = "--batch 32 --crop 96 --lr-g 4e-4 --lr-d 2e-4 --validate-every 250 --checkpoint-every 250"
 
@@ -194,7 +201,18 @@ def depth_command(args, model: str, workers: int) -> str:
             f"--ema {args.ema}{decay} "
             f"--minutes {args.minutes} --val-every {args.val_every} --val-count {args.val_count} "
             f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
-            f"--rank-weight {args.rank_weight:g}")
+            f"--rank-weight {args.rank_weight:g}"
+            + (f" --teacher-labels {c}/{TEACHER_LABELS} --teacher-weight {args.teacher_weight:g}" if args.teacher else ""))
+
+
+def teacher_command(args, weights: str) -> str:
+    """The teacher's labels, made there on the GPU by distill.py (the engine is not built
+    on that machine): its keep-aspect ensemble of the carried photos, the folder
+    train_depth.py --teacher-labels reads."""
+    c = args.carry
+    return (f"{args.python} training/distill.py --photos {c}/photos --out {c}/{TEACHER_LABELS} "
+            f"--teacher-checkpoint {weights} --resolutions {args.teacher_resolutions} --keep-aspect "
+            f"--device {args.device} --threads {args.threads}")
 
 
 def inpaint_command(args, workers: int) -> str:
@@ -208,12 +226,16 @@ def inpaint_command(args, workers: int) -> str:
             f"{shlex.join(shlex.split(args.inpaint_args))}")
 
 
-def train_script(args, names) -> str:
-    """The shell script the GPU machine runs from the repository's root: every run's
-    training side by side, then its slim checkpoint, best weights and logs into $OUT/NAME/."""
+def train_script(args, names, teacher_weights) -> str:
+    """The shell script the GPU machine runs from the repository's root: the teacher's
+    labels first (with --teacher), then every run's training side by side, then its slim
+    checkpoint, best weights and logs into $OUT/NAME/."""
     c, workers = args.carry, max(1, args.workers // len(names))
     lines = ["#!/bin/bash", "# written by training/gpu_run.py pack", "set -u",
              f"export AMPI_PHOTO_ROOT={c}/photos PYTHONUNBUFFERED=1", "pids=()"]
+    if teacher_weights:
+        lines.append(f"{teacher_command(args, teacher_weights)} > {c}/teacher.txt 2>&1 "
+                     f"|| {{ tail -n 20 {c}/teacher.txt; exit 1; }}")
     for name in names:
         command = inpaint_command(args, workers) if name == INPAINT else depth_command(args, name, workers)
         lines.append(f"{command} > {c}/{name}/console.txt 2>&1 & pids+=($!)")
@@ -241,12 +263,13 @@ def cmd_pack(args):
     sizes = pack_photos(carry / "photos")
     (carry / "ordinal.json").write_text(json.dumps(scaled_ordinal_set(args.ordinal, sizes)))
     planes = pack_planes(carry / "inpaint_planes", sizes, args.disparity_dir) if INPAINT in dict(runs) else 0
+    teacher_weights = carried_teacher(args, carry) if args.teacher else None
     for name, run in runs:
         (carry / name).mkdir(parents=True)
         checkpoint = run_files(name).checkpoint
         if (run / checkpoint).exists():  # best.pt stays here: the GPU writes one only if it beats it
             slim_checkpoint(run / checkpoint, carry / name / checkpoint)
-    (carry / "train.sh").write_text(train_script(args, [name for name, _ in runs]))
+    (carry / "train.sh").write_text(train_script(args, [name for name, _ in runs], teacher_weights))
     parts = {part.name: size_of(part) for part in sorted(carry.iterdir())}
     tree = tracked_bytes()
     total = tree + sum(parts.values())
@@ -261,10 +284,27 @@ def cmd_pack(args):
     print(f"bash {args.carry}/train.sh")
 
 
-def tracked_bytes() -> int:
+def tracked_files() -> list:
     import subprocess
     names = subprocess.run(["git", "ls-files", "-z"], cwd=ROOT, capture_output=True, check=True).stdout
-    return sum((ROOT / n).stat().st_size for n in names.decode().split("\0") if n and (ROOT / n).is_file())
+    return [ROOT / n for n in names.decode().split("\0") if n and (ROOT / n).is_file()]
+
+
+def tracked_bytes() -> int:
+    return sum(path.stat().st_size for path in tracked_files())
+
+
+def carried_teacher(args, carry: Path) -> str:
+    """The teacher's weights as the GPU machine finds them: a file of the working tree
+    (the bundled weights) travels with it; any other is copied into the carried folder."""
+    weights = Path(args.teacher).resolve()
+    if weights.suffix != ".ampw" or not weights.is_file():
+        raise SystemExit(f"--teacher {args.teacher}: expected a depth network's .ampw file (export_depth.py)")
+    if weights in tracked_files():
+        return weights.relative_to(ROOT).as_posix()
+    (carry / "teacher_weights").mkdir()
+    shutil.copyfile(weights, carry / "teacher_weights" / weights.name)
+    return f"{args.carry}/teacher_weights/{weights.name}"
 
 
 # ---- slim, unpack ---------------------------------------------------------------------------
@@ -334,6 +374,12 @@ def main(argv=None):
     depth.add_argument("--rank-weight", type=float, default=8.0,
                        help="weight of the ranking loss on the photos' pairs (the bundled lite's run: 8)")
     depth.add_argument("--val-every", type=int, default=500)
+    depth.add_argument("--teacher", help="self-distillation: a depth .ampw whose keep-aspect ensemble "
+                                         "labels the carried photos there, for --teacher-labels (e.g. "
+                                         "weights/depth_lite.ampw)")
+    depth.add_argument("--teacher-weight", type=float, default=1.0, help="weight of the loss on the teacher's labels")
+    depth.add_argument("--teacher-resolutions", default="192,224,256,288,320",
+                       help="the ensemble's long sides (those of the bundled lite's teacher, training/DEPTH.md)")
     inpaint = pack.add_argument_group("the inpainting run")
     inpaint.add_argument("--disparity-dir", default=inpaint_data.DEFAULT_DISPARITY_DIR,
                          help="cached disparity maps (inpaint_data.py --write-disparity) to carry as plane maps")

@@ -2,6 +2,7 @@
 `/usr/bin/python3 -m unittest training/test_distill.py`). Small squares keep it fast; the
 paper's resolutions are checked as the default."""
 import sys
+import tempfile
 import unittest
 from pathlib import Path
 
@@ -96,6 +97,44 @@ class PseudoGroundTruth(unittest.TestCase):
     def test_bad_photo_is_an_error(self):
         with self.assertRaisesRegex(ValueError, "H x W x 3"):
             distill.ensemble_predictions(np.zeros((8, 8), np.float32), red_teacher, SMALL)
+
+
+class LabelFolder(unittest.TestCase):
+    """distill.py's folder serves train_depth.py as `ampi distill`'s does: labels.tsv
+    with the recipe, a line per labelled photo, resumable, and refusing a folder that is
+    not its own."""
+
+    def photos(self, root: Path) -> Path:
+        from PIL import Image
+        for i, name in enumerate(("a/one.jpg", "a/two.png", "b/three.jpg")):
+            (root / name).parent.mkdir(parents=True, exist_ok=True)
+            Image.fromarray((test_photo(30, 44, seed=i) * 255).astype(np.uint8)).save(root / name)
+        return root
+
+    def test_labels_resume_and_refusals(self):
+        with tempfile.TemporaryDirectory() as folder:
+            photos, out = self.photos(Path(folder) / "photos"), Path(folder) / "labels"
+            distill.label_folder(photos, out, red_teacher, (32, 48), keep_aspect=True,
+                                 teacher_name="teacher\tred\t-\t-")
+            lines = (out / "labels.tsv").read_text().splitlines()
+            self.assertEqual(lines[:4], ["ampi-distill\t1", "teacher\tred\t-\t-", "resolutions\t32,48\taspect kept",
+                                         f"images\t{photos.resolve()}"])
+            self.assertEqual(lines[4:], ["a_one.npy\ta/one.jpg", "a_two.npy\ta/two.png", "b_three.npy\tb/three.jpg"])
+            images, labels = distill.read_label_folder(out)
+            self.assertEqual(images, photos.resolve())
+            self.assertEqual(distill.read_disparity(labels["a/two.png"]).shape, (30, 44))
+
+            def must_not_run(rgb):
+                raise AssertionError("a labelled photo was labelled again")
+
+            distill.label_folder(photos, out, must_not_run, (32, 48), keep_aspect=True,
+                                 teacher_name="teacher\tred\t-\t-")
+            with self.assertRaisesRegex(SystemExit, "another teacher, resolutions or photo folder"):
+                distill.label_folder(photos, out, red_teacher, (32, 64), keep_aspect=True,
+                                     teacher_name="teacher\tred\t-\t-")
+            (out / "labels.tsv").unlink()
+            with self.assertRaisesRegex(SystemExit, "not empty and has no labels.tsv"):
+                distill.label_folder(photos, out, red_teacher, (32, 48), teacher_name="teacher\tred\t-\t-")
 
 
 if __name__ == "__main__":

@@ -82,6 +82,8 @@ class RoundTrip(unittest.TestCase):
                                         "--threads", "1", "--workers", "2", "--scene-reuse", "2", "--val-count", "2",
                                         "--lr-decay", "cosine", "--decay-steps", "1000",
                                         "--disparity-dir", str(tmp / "disparity"),
+                                        "--teacher", "weights/depth_lite.ampw", "--teacher-weight", "0.5",
+                                        "--teacher-resolutions", "64,96",
                                         "--inpaint-args=--max-photos 3 --batch 2 --crop 64 --log-every 2 "
                                         "--validate-every 2 --checkpoint-every 2", env=env)
                 packed = json.loads((carry / "ordinal.json").read_text())["photos"][0]
@@ -103,6 +105,7 @@ class RoundTrip(unittest.TestCase):
                 done = subprocess.run(["bash", "-c", command], cwd=ROOT, env=dict(env, OUT=str(out)),
                                       capture_output=True, text=True)
                 self.assertEqual(done.returncode, 0, done.stdout + done.stderr)
+                self.check_teacher_labels(carry)
                 self.run_tool("unpack", str(out), *run_args)
                 for name in ("checkpoint.pt", "best.pt", "train.log"):
                     self.assertTrue((runs["lite"] / name).exists(), f"lite {name}")
@@ -120,11 +123,27 @@ class RoundTrip(unittest.TestCase):
             self.assertIn("initialised lite from weights/depth_lite.ampw", log)
             self.assertIn("(slim: Adam restarts)", log)
             self.assertIn("weights averaged (decay 0.999)", log)
-            self.assertIn("rank weight 8)", log)
+            self.assertIn("rank weight 8, teacher", log)
             self.assertIn("cosine decay from 1.00e-03 to 1.00e-05 at step 1000", log)
             self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
             self.assertIn("ordinal_whdr", log)
+            self.assertEqual(log.count(f"teacher's labels {carry}/teacher weight 0.5"), 2)
             self.check_inpaint_logs(runs["inpaint"])
+
+    def check_teacher_labels(self, carry: Path):
+        """The GPU machine labelled every carried photo with the carried teacher's
+        ensemble, in a folder train_depth.py --teacher-labels reads."""
+        lines = (carry / "teacher" / "labels.tsv").read_text().splitlines()
+        self.assertEqual(lines[:3], ["ampi-distill\t1", "teacher\tdepth_lite.ampw\tampi.depth.dwt-mobilenetv3\tlite",
+                                     "resolutions\t64,96\taspect kept"])
+        self.assertEqual(lines[3], f"images\t{(carry / 'photos').resolve()}")
+        self.assertEqual(sorted(lines[4:]), [f"set_p{i}.npy\tset/p{i}.jpg" for i in range(10)])
+        label = np.load(carry / "teacher" / "set_p0.npy")
+        self.assertEqual(label.shape, (128, 384))
+        self.assertGreaterEqual(float(label.min()), 0.0)   # [0, 1] at the ensemble's size, then resized
+        self.assertGreater(float(label.max() - label.min()), 0.9)
+        self.assertFalse((carry / "teacher_weights").exists())   # the bundled file travels with the tree
+        self.assertIn("--teacher-checkpoint weights/depth_lite.ampw", (carry / "train.sh").read_text())
 
     def check_plane_map(self, carry: Path, disparity: Path):
         """A carried plane map is what the inpainting data slices from the map at the
@@ -161,6 +180,19 @@ class RoundTrip(unittest.TestCase):
             self.assertIn("more than the device tool's 1 MiB", message)
             self.assertIn("photos 0.2", message)
             self.assertNotIn("\n", message)
+
+    def test_a_teacher_outside_the_tree_is_carried(self):
+        with tempfile.TemporaryDirectory() as folder:
+            tmp = Path(folder)
+            teacher, carry = tmp / "teacher.ampw", tmp / "carry"
+            teacher.write_bytes(b"weights")
+            carry.mkdir()
+            args = argparse.Namespace(teacher=str(teacher), carry="carry")
+            self.assertEqual(gpu_run.carried_teacher(args, carry), "carry/teacher_weights/teacher.ampw")
+            self.assertEqual((carry / "teacher_weights" / "teacher.ampw").read_bytes(), b"weights")
+            for wrong in (tmp / "missing.ampw", tmp / "checkpoint.pt"):
+                with self.assertRaisesRegex(SystemExit, "expected a depth network's .ampw file"):
+                    gpu_run.carried_teacher(argparse.Namespace(teacher=str(wrong), carry="carry"), carry)
 
     def test_unpack_without_files_leaves_the_run_alone(self):
         with tempfile.TemporaryDirectory() as folder:
