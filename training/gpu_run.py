@@ -259,6 +259,8 @@ def cmd_pack(args):
     carry, runs = Path(args.carry), parse_runs(args.run)
     if args.lr_decay == "cosine" and args.decay_steps <= 0:
         raise SystemExit("gpu_run.py pack: --lr-decay cosine needs --decay-steps N (N > 0)")
+    if args.teacher and all(name == INPAINT for name, _ in runs):
+        raise SystemExit("gpu_run.py pack: --teacher labels photos for depth runs; give a --run lite:DIR or heavy:DIR")
     if carry.exists():
         shutil.rmtree(carry)
     sizes = pack_photos(carry / "photos")

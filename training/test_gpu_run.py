@@ -190,6 +190,9 @@ class RoundTrip(unittest.TestCase):
             args = argparse.Namespace(teacher=str(teacher), carry="carry")
             self.assertEqual(gpu_run.carried_teacher(args, carry), "carry/teacher_weights/teacher.ampw")
             self.assertEqual((carry / "teacher_weights" / "teacher.ampw").read_bytes(), b"weights")
+            with contextlib.redirect_stdout(io.StringIO()), self.assertRaisesRegex(SystemExit, "for depth runs"):
+                gpu_run.main(["pack", "--run", f"inpaint:{tmp / 'inpaint'}", "--carry", str(carry),
+                              "--teacher", str(teacher)])
             for wrong in (tmp / "missing.ampw", tmp / "checkpoint.pt"):
                 with self.assertRaisesRegex(SystemExit, "expected a depth network's .ampw file"):
                     gpu_run.carried_teacher(argparse.Namespace(teacher=str(wrong), carry="carry"), carry)
