@@ -1,7 +1,8 @@
 """The GPU round trip of training/gpu_run.py, at a tiny size on the CPU: pack a photo
 folder, an ordinal set, disparity maps and two runs (lite, inpaint) into a carry folder,
-run the device command there (with --device cpu), unpack what it wrote to $OUT, and do it
-again: the second runs resume. pack's refusal of more than the device tool carries. And
+run the device command there (with --device cpu: the teacher's labels first, then both
+trainings), unpack what it wrote to $OUT, and do it again: the second runs resume. pack's
+refusal of more than the device tool carries, and how it carries a teacher. And
 train_depth.py's cosine learning-rate decay: its values, and a run resumed from a slim
 checkpoint continuing the curve."""
 import argparse
