@@ -266,7 +266,8 @@ def cmd_pack(args):
     sizes = pack_photos(carry / "photos")
     (carry / "ordinal.json").write_text(json.dumps(scaled_ordinal_set(args.ordinal, sizes), separators=(",", ":")))
     planes = pack_planes(carry / "inpaint_planes", sizes, args.disparity_dir) if INPAINT in dict(runs) else 0
-    teacher_weights = carried_teacher(args, carry) if args.teacher else None
+    tracked = tracked_files()
+    teacher_weights = carried_teacher(args, carry, tracked) if args.teacher else None
     for name, run in runs:
         (carry / name).mkdir(parents=True)
         checkpoint = run_files(name).checkpoint
@@ -274,7 +275,7 @@ def cmd_pack(args):
             slim_checkpoint(run / checkpoint, carry / name / checkpoint)
     (carry / "train.sh").write_text(train_script(args, [name for name, _ in runs], teacher_weights))
     parts = {part.name: size_of(part) for part in sorted(carry.iterdir())}
-    tree = tracked_bytes()
+    tree = sum(path.stat().st_size for path in tracked)
     total = tree + sum(parts.values())
     shown = f"the working tree {tree / 2 ** 20:.1f}, " + ", ".join(
         f"{name} {size / 2 ** 20:.1f}" for name, size in parts.items())
@@ -293,17 +294,13 @@ def tracked_files() -> list:
     return [ROOT / n for n in names.decode().split("\0") if n and (ROOT / n).is_file()]
 
 
-def tracked_bytes() -> int:
-    return sum(path.stat().st_size for path in tracked_files())
-
-
-def carried_teacher(args, carry: Path) -> str:
+def carried_teacher(args, carry: Path, tracked: list) -> str:
     """The teacher's weights as the GPU machine finds them: a file of the working tree
     (the bundled weights) travels with it; any other is copied into the carried folder."""
     weights = Path(args.teacher).resolve()
     if weights.suffix != ".ampw" or not weights.is_file():
         raise SystemExit(f"--teacher {args.teacher}: expected a depth network's .ampw file (export_depth.py)")
-    if weights in tracked_files():
+    if weights in tracked:
         return weights.relative_to(ROOT).as_posix()
     (carry / "teacher_weights").mkdir()
     shutil.copyfile(weights, carry / "teacher_weights" / weights.name)

@@ -182,21 +182,24 @@ class RoundTrip(unittest.TestCase):
             self.assertRegex(message, r"photos \d+\.\d,")   # each part named, with its size
             self.assertNotIn("\n", message)
 
-    def test_a_teacher_outside_the_tree_is_carried(self):
+    def test_a_teacher_outside_the_tree_is_carried_a_bundled_one_travels_with_it(self):
         with tempfile.TemporaryDirectory() as folder:
             tmp = Path(folder)
             teacher, carry = tmp / "teacher.ampw", tmp / "carry"
             teacher.write_bytes(b"weights")
             carry.mkdir()
             args = argparse.Namespace(teacher=str(teacher), carry="carry")
-            self.assertEqual(gpu_run.carried_teacher(args, carry), "carry/teacher_weights/teacher.ampw")
+            tracked = gpu_run.tracked_files()
+            self.assertEqual(gpu_run.carried_teacher(args, carry, tracked), "carry/teacher_weights/teacher.ampw")
             self.assertEqual((carry / "teacher_weights" / "teacher.ampw").read_bytes(), b"weights")
             with contextlib.redirect_stdout(io.StringIO()), self.assertRaisesRegex(SystemExit, "for depth runs"):
                 gpu_run.main(["pack", "--run", f"inpaint:{tmp / 'inpaint'}", "--carry", str(carry),
                               "--teacher", str(teacher)])
             for wrong in (tmp / "missing.ampw", tmp / "checkpoint.pt"):
                 with self.assertRaisesRegex(SystemExit, "expected a depth network's .ampw file"):
-                    gpu_run.carried_teacher(argparse.Namespace(teacher=str(wrong), carry="carry"), carry)
+                    gpu_run.carried_teacher(argparse.Namespace(teacher=str(wrong), carry="carry"), carry, tracked)
+            bundled = argparse.Namespace(teacher=str(gpu_run.ROOT / "weights" / "depth_lite.ampw"), carry="carry")
+            self.assertEqual(gpu_run.carried_teacher(bundled, carry, tracked), "weights/depth_lite.ampw")
 
     def test_unpack_without_files_leaves_the_run_alone(self):
         with tempfile.TemporaryDirectory() as folder:
