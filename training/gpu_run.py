@@ -296,7 +296,8 @@ def tracked_files() -> list:
 
 def carried_teacher(args, carry: Path, tracked: list) -> str:
     """The teacher's weights as the GPU machine finds them: a file of the working tree
-    (the bundled weights) travels with it; any other is copied into the carried folder."""
+    (`tracked`, as tracked_files() lists it: the bundled weights) travels with it; any
+    other is copied into the carried folder."""
     weights = Path(args.teacher).resolve()
     if weights.suffix != ".ampw" or not weights.is_file():
         raise SystemExit(f"--teacher {args.teacher}: expected a depth network's .ampw file (export_depth.py)")

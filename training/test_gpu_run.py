@@ -182,7 +182,7 @@ class RoundTrip(unittest.TestCase):
             self.assertRegex(message, r"photos \d+\.\d,")   # each part named, with its size
             self.assertNotIn("\n", message)
 
-    def test_a_teacher_outside_the_tree_is_carried_a_bundled_one_travels_with_it(self):
+    def test_a_bundled_teacher_travels_with_the_tree_any_other_is_carried(self):
         with tempfile.TemporaryDirectory() as folder:
             tmp = Path(folder)
             teacher, carry = tmp / "teacher.ampw", tmp / "carry"
