@@ -195,11 +195,12 @@ def depth_command(args, model: str, workers: int) -> str:
     """A first run starts from the bundled weights; later ones resume the carried
     checkpoint (--init is then ignored)."""
     c = args.carry
+    lr = f" --lr {args.lr:g}" if args.lr is not None else ""   # else train_depth.py's default
     decay = f" --lr-decay cosine --decay-steps {args.decay_steps}" if args.lr_decay == "cosine" else ""
     return (f"{args.python} training/train_depth.py --model {model} --run {c}/{model} --data scenes "
             f"--size {args.size} --batch {args.batch} --init weights/depth_{model}.ampw --steps 10000000 "
             f"--device {args.device} --threads {args.threads} --workers {workers} --scene-reuse {args.scene_reuse} "
-            f"--lr {args.lr:g} --ema {args.ema}{decay} "
+            f"--ema {args.ema}{lr}{decay} "
             f"--minutes {args.minutes} --val-every {args.val_every} --val-count {args.val_count} "
             f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
             f"--rank-weight {args.rank_weight:g}"
@@ -364,7 +365,8 @@ def main(argv=None):
     depth.add_argument("--scene-reuse", type=int, default=4, help="steps each rendered scene batch trains")
     depth.add_argument("--ema", type=float, default=0.999,
                        help="decay of the weight average that validation measures (0: none)")
-    depth.add_argument("--lr", type=float, default=1e-3, help="the depth runs' (starting) learning rate")
+    depth.add_argument("--lr", type=float,
+                       help="the depth runs' (starting) learning rate (default: train_depth.py's own)")
     depth.add_argument("--lr-decay", choices=("none", "cosine"), default="none",
                        help="none: lr x0.2 on a plateau; cosine: lr falls by the step (train_depth.py)")
     depth.add_argument("--decay-steps", type=int, default=0,
