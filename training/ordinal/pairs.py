@@ -45,7 +45,7 @@ EDGE_OFFSET = 0.02       # edge pair points this share of the long side from the
 EDGE_QUANTILE = 0.98     # edge pixels: gradient magnitude above this quantile
 DISPLAY_LONG_SIDE = 1024
 ZOOM = 4.5                # edge pairs again below the photo, this many times the shown size
-ROUNDS = 17
+ROUNDS = 19
 # The validation photos' pairs of these rounds are the test part (split 'test'): no
 # network is ever selected on them. Rounds 1 and 2 of the validation photos had picked
 # the bundled networks, and on the fresh round 3 lite scored far worse than on them.
