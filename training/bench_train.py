@@ -1,23 +1,27 @@
 """Training throughput of the depth network: samples per hour at 256x192 (forward,
-backward, optimiser and data included), for the old way (one thread, scenes made in the
-loop) and the current one (every core, batches made ahead by a worker), written to
-training/BENCH_TRAIN.md.
+backward, optimiser and data included), for the old ways (one thread, scenes made in the
+loop; glibc's malloc thresholds left as they are) and the current one (every core,
+batches made ahead by a worker, freed blocks kept by training/malloc_reuse.py), written
+to training/BENCH_TRAIN.md.
 
     /usr/bin/python3 training/bench_train.py [--steps 20] [--model lite]
 
-Each row is a short real run of train_depth.py in a temporary folder, timed from the end
-of its first step to the end of its last (start-up, validation and checkpoints left out).
+Each row is a short real run of train_depth.py in a temporary folder and a process of its
+own, timed from the end of its first step to the end of its last (start-up, validation and
+checkpoints left out).
 The rows run one after another on one machine: compare them with each other, and say how
 busy the machine was (the load average is printed into the table).
 """
 from __future__ import annotations
 
 import argparse
+import multiprocessing
 import os
 import platform
 import sys
 import tempfile
 import time
+from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -30,13 +34,15 @@ ORDINAL = HERE / "ordinal" / "ordinal.json"
 
 def configurations(cores: int):
     """(name, train_depth arguments) of each row."""
-    rows = [("1 thread, scenes in the loop, batch 4 (the former setup)",
-             ["--threads", "1", "--workers", "0", "--batch", "4"]),
+    rows = [("1 thread, scenes in the loop, batch 4, glibc's malloc thresholds (the first setup)",
+             ["--threads", "1", "--workers", "0", "--batch", "4", "--malloc-defaults"]),
             (f"{cores} threads, 1 worker, batch 8 scenes",
              ["--threads", str(cores), "--workers", "1", "--batch", "8"])]
     if ORDINAL.exists():
-        rows.append((f"{cores} threads, 1 worker, batch 4 scenes + 4 real photos (ranking loss)",
-                     ["--threads", str(cores), "--workers", "1", "--batch", "4", "--ordinal", str(ORDINAL)]))
+        photos = ["--threads", str(cores), "--workers", "1", "--batch", "4", "--ordinal", str(ORDINAL)]
+        rows.append((f"{cores} threads, 1 worker, batch 4 scenes + 4 real photos (ranking loss), "
+                     "glibc's malloc thresholds (the setup before malloc_reuse.py)", photos + ["--malloc-defaults"]))
+        rows.append((f"{cores} threads, 1 worker, batch 4 scenes + 4 real photos (ranking loss)", photos))
     return rows
 
 
@@ -51,10 +57,15 @@ def processor_name() -> str:
 
 
 def measure(model: str, size: str, steps: int, extra):
+    """One row, in a process of its own (forked from this one, which never trains): the
+    malloc settings (training/malloc_reuse.py) and the thread pools of one row must not
+    carry over to the next."""
     with tempfile.TemporaryDirectory() as run:
-        result = train_depth.main(["--model", model, "--run", run, "--data", "scenes", "--size", size,
-                                   "--steps", str(steps + 1), "--val-every", str(10 ** 9), "--val-count", "1",
-                                   "--checkpoint-every", str(10 ** 9), "--log-every", str(10 ** 9)] + extra)
+        argv = ["--model", model, "--run", run, "--data", "scenes", "--size", size,
+                "--steps", str(steps + 1), "--val-every", str(10 ** 9), "--val-count", "1",
+                "--checkpoint-every", str(10 ** 9), "--log-every", str(10 ** 9)] + extra
+        with ProcessPoolExecutor(1, mp_context=multiprocessing.get_context("fork")) as pool:
+            result = pool.submit(train_depth.main, argv).result()
     seconds_per_step = result["seconds"] / result["steps"]
     return seconds_per_step, 3600 * result["samples_per_step"] / seconds_per_step
 

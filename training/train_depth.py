@@ -51,6 +51,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import depth_model  # noqa: E402
 import distill  # noqa: E402
 import losses  # noqa: E402
+import malloc_reuse  # noqa: E402
 import ordinal_data  # noqa: E402
 
 VAL_SEED_START = 1_000_000_000  # synthetic validation scenes; training seeds stay below
@@ -442,6 +443,8 @@ def resume(ckpt_path: Path, model, average, optimiser, scheduler, args, best_of:
 
 
 def train(args):
+    if not args.malloc_defaults:
+        malloc_reuse.keep_freed_blocks()
     torch.set_num_threads(args.threads)
     torch.manual_seed(args.seed)
     run = Path(args.run)
@@ -589,6 +592,8 @@ def main(argv=None):
     p.add_argument("--ema", type=float, default=0.0,
                    help="validate and keep an exponential moving average of the weights with this decay "
                         "(e.g. 0.999; 0: the weights as trained)")
+    p.add_argument("--malloc-defaults", action="store_true",
+                   help="leave glibc's malloc thresholds as they are (training/malloc_reuse.py: for a comparison)")
     args = p.parse_args(argv)
     if args.teacher_labels and not args.ordinal:
         raise SystemExit("train_depth.py: --teacher-labels labels the --ordinal training photos; give --ordinal")

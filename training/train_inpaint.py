@@ -51,6 +51,7 @@ import depth_model  # noqa: E402
 import inpaint_data as data  # noqa: E402
 from inpaint_model import PREFILL, InpaintGenerator, PatchDiscriminator  # noqa: E402
 from losses import gradient_loss  # noqa: E402
+import malloc_reuse  # noqa: E402
 from export_inpaint import import_ampw as import_generator  # noqa: E402
 from train_depth import batches_ahead, log_line, save_checkpoint  # noqa: E402
 
@@ -268,6 +269,7 @@ def networks(args, log):
 
 def main(argv=None):
     args = parse_args(argv)
+    malloc_reuse.keep_freed_blocks()
     torch.set_num_threads(args.threads)
     os.makedirs(args.run_dir, exist_ok=True)
 
