@@ -6,10 +6,10 @@ blocks are freed, at most to 32 MB) with a fresh mmap and unmaps it when freed, 
 the top of the heap back once more than its trim threshold is free there. A training
 step allocates and frees activations and gradients of tens of megabytes, so every step
 paid page faults and the kernel zeroing those pages again: vmstat put a fifth to a third
-of the CPU time in the system. With both thresholds out of reach the blocks stay in the heap and are
-reused: lite on 2 threads, 4 scenes + 4 photos a step, 1.26 s a step before and 0.67 after
-(training/BENCH_TRAIN.md). The cost: a process holds the largest heap it ever needed
-until it ends."""
+of the CPU time in the system. With both thresholds out of reach the blocks stay in the
+heap and are reused: lite on 2 threads, 4 scenes + 4 photos a step, 1.26 s a step before
+and 0.67 after (training/BENCH_TRAIN.md). The cost: a process holds the largest heap it
+ever needed until it ends."""
 from __future__ import annotations
 
 import ctypes
