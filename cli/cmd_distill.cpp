@@ -107,12 +107,13 @@ DistillOptions parse(int argc, char** argv, bool& help) {
 }
 
 // The photos under `images`, relative to it; two photos whose labels would share a name
-// (a/b_c.jpg and a_b/c.jpg, or x.jpg and x.png) are refused before any work.
+// (a/b_c.jpg and a_b/c.jpg, or x.jpg and x.png) are refused before any work. Lexically
+// relative: a photo in a linked folder keeps the name it has under `images`.
 std::vector<std::string> relative_photos(const std::string& images) {
   std::vector<std::string> photos;
   std::map<std::string, std::string> by_label;
   for (const std::string& path : list_images(images)) {
-    const std::string relative = fs::relative(path, images).generic_string();
+    const std::string relative = fs::path(path).lexically_relative(images).generic_string();
     const auto [it, added] = by_label.emplace(label_name(relative), relative);
     if (!added)
       throw std::runtime_error(images + ": " + it->second + " and " + relative + " would share the label " + it->first);

@@ -13,7 +13,8 @@ namespace fs = std::filesystem;
 std::vector<std::string> list_images(const std::string& dir) {
   if (!fs::is_directory(dir)) throw std::runtime_error(dir + ": not a directory");
   std::vector<std::string> found;
-  for (const auto& entry : fs::recursive_directory_iterator(dir)) {
+  // Linked folders are followed: training/archive_photos.py's photo root links ../shared's.
+  for (const auto& entry : fs::recursive_directory_iterator(dir, fs::directory_options::follow_directory_symlink)) {
     if (!entry.is_regular_file()) continue;
     std::string ext = entry.path().extension().string();
     std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });

@@ -36,6 +36,7 @@ import torch
 import torch.nn.functional as F
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))   # depth_model, export_depth, ampw
+import photo_folder  # noqa: E402  (the photo listing)
 
 PAPER_RESOLUTIONS = (512, 768, 1024, 1600, 1920)
 
@@ -189,7 +190,7 @@ def label_folder(photos: Path, out: Path, teacher: Teacher, resolutions: Sequenc
               f"resolutions\t{','.join(map(str, resolutions))}" + ("\taspect kept" if keep_aspect else ""),
               f"images\t{photos.resolve()}"]
     done = open_manifest(out, header)
-    names = sorted(p for p in photos.rglob("*") if p.suffix.lower() in (".jpg", ".jpeg", ".png"))
+    names = photo_folder.image_files(photos)
     for i, path in enumerate(names):
         rel = path.relative_to(photos).as_posix()
         if rel in done:

@@ -20,6 +20,9 @@ DEFAULT_PHOTO_ROOT = Path(__file__).resolve().parents[2] / 'shared' / 'data' / '
 VALIDATION_SEED_START = 10 ** 9
 VALIDATION_PHOTO_PERIOD = 10      # every tenth photo of a folder (by sorted name) is validation
 ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validation (training/ordinal)
+# Folders whose photos are all training photos: training/archive_photos.py's, added after
+# the splits were fixed, so that validation and test stay the photos they were.
+TRAINING_ONLY_FOLDERS = {'archive'}
 
 
 def is_validation_seed(seed):
@@ -46,8 +49,14 @@ def _every_nth_of_folder(path, period):
     return names.index(path.name) % period == period - 1
 
 
+def _training_only(path):
+    return Path(path).parent.name in TRAINING_ONLY_FOLDERS
+
+
 def photo_split(path):
     """'val' for every tenth photo of its folder by sorted name, else 'train'."""
+    if _training_only(path):
+        return 'train'
     return 'val' if _every_nth_of_folder(path, VALIDATION_PHOTO_PERIOD) else 'train'
 
 
@@ -55,6 +64,8 @@ def ordinal_split(path):
     """'val' for every fifth photo of its folder by sorted name (the synthetic validation
     photos and as many more), else 'train'. Ordinal validation photos are never trained on:
     not ranked, and not textures of training scenes either."""
+    if _training_only(path):
+        return 'train'
     return 'val' if _every_nth_of_folder(path, ORDINAL_VALIDATION_PERIOD) else 'train'
 
 
@@ -62,12 +73,19 @@ def photo_root():
     return Path(os.environ.get('AMPI_PHOTO_ROOT', DEFAULT_PHOTO_ROOT))
 
 
+def image_files(root):
+    """Every photo under root, sorted, linked folders followed (training/archive_photos.py's
+    root links ../shared's folders)."""
+    return sorted(Path(folder) / name for folder, _subfolders, names in os.walk(root, followlinks=True)
+                  for name in names if Path(name).suffix.lower() in PHOTO_SUFFIXES)
+
+
 def list_photos(split=None, root=None):
     """Sorted photo paths under root (default: $AMPI_PHOTO_ROOT or ../shared/data/photos)."""
     root = Path(root) if root is not None else photo_root()
     if not root.is_dir():
         raise RuntimeError(f'{root}: photo folder not found (set AMPI_PHOTO_ROOT)')
-    paths = sorted(p for p in root.rglob('*') if p.suffix.lower() in PHOTO_SUFFIXES)
+    paths = image_files(root)
     if split is not None:
         paths = [p for p in paths if photo_split(p) == split]
     if not paths:

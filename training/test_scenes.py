@@ -252,6 +252,23 @@ class ValidationSplit(unittest.TestCase):
                 self.assertTrue(used)
                 self.assertLessEqual(used, owned)
 
+    def test_a_root_of_linked_folders_splits_as_the_folders_do_and_archive_photos_train(self):
+        """training/archive_photos.py's root: ../shared's folders linked, archive/ beside them."""
+        shared = photo_folder.photo_root()
+        with tempfile.TemporaryDirectory() as tmp:
+            root = Path(tmp)
+            (root / 'kodak24').symlink_to(shared / 'kodak24', target_is_directory=True)
+            (root / 'archive').mkdir()
+            for n in range(10):
+                (root / 'archive' / f'photo_{n}.jpg').write_bytes(b'')
+            photos = photo_folder.list_photos(root=root)
+            linked = [p for p in photos if p.parent.name == 'kodak24']
+            self.assertEqual([p.name for p in linked], [p.name for p in photo_folder.list_photos(root=shared / 'kodak24')])
+            self.assertTrue(all(p.is_relative_to(root) for p in photos))
+            for split in (photo_folder.photo_split, photo_folder.ordinal_split):
+                self.assertEqual([split(p) for p in linked], [split(shared / 'kodak24' / p.name) for p in linked])
+                self.assertEqual({split(p) for p in photos if p.parent.name == 'archive'}, {'train'})
+
     def test_bad_paths_are_named_in_the_error(self):
         with self.assertRaisesRegex(ValueError, 'notes.txt'):
             photo_folder.photo_split(photo_folder.photo_root() / 'kodak24' / 'notes.txt')

@@ -80,6 +80,16 @@ expect_error "not empty and not made by ampi distill" "$ampi" distill --teacher 
 [ "$(cat "$tmp/mine/notes.txt")" = keep ] || fail "the user's folder was touched"
 [ "$(ls -l "$tmp/labels" | md5sum)" = "$before" ] || fail "a refused run changed the label folder"
 
+# A linked folder (training/archive_photos.py's photo root) is followed, and its photos keep
+# the names they have under --images.
+mkdir "$tmp/root" && ln -s "$tmp/photos/sub" "$tmp/root/linked"
+"$ampi" distill --teacher "$teacher" --images "$tmp/root/" -o "$tmp/linked_labels" --resolutions 32 --threads 2 \
+  >"$tmp/log" 2>&1 || fail "linked folder: $(cat "$tmp/log")"
+grep -q "^linked_b.png	linked/b.png$" "$tmp/linked_labels/labels.tsv" \
+  || fail "linked folder: labels.tsv $(tail -n +5 "$tmp/linked_labels/labels.tsv")"
+[ "$(ls -A "$tmp/linked_labels")" = "$(printf 'labels.tsv\nlinked_b.png')" ] \
+  || fail "linked folder: labels $(ls -A "$tmp/linked_labels")"
+
 # The folder trains: two steps of lite on it.
 /usr/bin/python3 "$src/training/train_depth.py" --model lite --run "$tmp/run" --data "distilled:$tmp/labels" \
   --size 64x64 --batch 2 --steps 2 --val-every 2 --val-count 1 --workers 0 >"$tmp/train.log" 2>&1 \

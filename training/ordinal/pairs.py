@@ -2,9 +2,13 @@
 """The real-photo ordinal set: point pairs drawn on the photos, marked images to label
 them by eye, and the merged label file.
 
+    export AMPI_PHOTO_ROOT=training/data_cache/photos  # ../shared's photos and the archive's
     /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json
     /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--round N] [--only REL...]
     /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
+
+(training/archive_photos.py makes that root; `sample` from ../shared alone would leave the
+archive photos out.)
 
 Pairs come from a fixed seed and each photo's own name, so `sample` always makes the same
 file. Per photo and round: RANDOM_PAIRS pairs of points uniform over the photo, and
