@@ -3,7 +3,7 @@
 
     /usr/bin/python3 eval/make_tables.py depth   --ampi build/ampi   # bench/RESULTS-depth-eval.md
     /usr/bin/python3 eval/make_tables.py slicing --ampi build/ampi   # bench/RESULTS-slicing.md
-    /usr/bin/python3 eval/make_tables.py ordinal --ampi build/ampi   # bench/RESULTS-ordinal.md
+    AMPI_PHOTO_ROOT=training/data_cache/photos /usr/bin/python3 eval/make_tables.py ordinal --ampi build/ampi  # bench/RESULTS-ordinal.md
     /usr/bin/python3 eval/make_tables.py edges   --ampi build/ampi   # bench/RESULTS-edges.md
 
 depth: 50 synthetic validation scenes (training/make_eval_scenes.py: exact disparity,
@@ -123,9 +123,11 @@ def ordinal_table(ampi, threads):
     lines = [
         '# Depth order on real photos (`ampi eval depth --ordinal`)',
         '',
-        'Made by `/usr/bin/python3 eval/make_tables.py ordinal --ampi AMPI`: the bundled networks on',
-        'the real-photo ordinal set (`training/ordinal/`, point pairs labelled by looking at the',
-        'photos of `../shared/data/photos`, PHOTOS below). WHDR is the share of pairs labelled A or',
+        'Made by `AMPI_PHOTO_ROOT=training/data_cache/photos /usr/bin/python3 eval/make_tables.py',
+        'ordinal --ampi AMPI`: the bundled networks on the real-photo ordinal set',
+        '(`training/ordinal/`, point pairs labelled by looking at the photos of',
+        "`../shared/data/photos` and the archive's training photos, `training/archive_photos.py`;",
+        'PHOTOS below is the root that holds both). WHDR is the share of pairs labelled A or',
         'B nearer whose order the disparity gets wrong, a tie counting half; lower is better.',
         '`vertical-gradient` (lower = nearer) and `constant` are the guesses a network must beat.',
         'The validation photos (every fifth of each folder) are never trained on: their pairs of',
