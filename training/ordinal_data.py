@@ -53,7 +53,13 @@ def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE, 
         pairs = [p for p in entry["pairs"] if p["label"] in ("A", "B")]
         if not pairs:
             continue
-        with Image.open(Path(photo_root) / entry["photo"]) as image:
+        path = Path(photo_root) / entry["photo"]
+        if not path.is_file():
+            raise RuntimeError(f"{ordinal_file}: {entry['photo']} is not under {photo_root}"
+                               + (" (the archive photos: run training/archive_photos.py and set "
+                                  "AMPI_PHOTO_ROOT=training/data_cache/photos)"
+                                  if entry["photo"].startswith("archive/") else ""))
+        with Image.open(path) as image:
             image = ImageOps.exif_transpose(image).convert("RGB")
         if image.size != (entry["width"], entry["height"]):
             raise RuntimeError(f"{entry['photo']}: is {image.size}, labelled at {entry['width']}x{entry['height']}")

@@ -94,6 +94,10 @@ class Reading(unittest.TestCase):
             (root / "set.json").write_text(json.dumps({"photos": [entry]}))
             with self.assertRaisesRegex(RuntimeError, "a.png: is \\(100, 80\\), labelled at 120x80"):
                 ordinal_data.load_split("val", root, root / "set.json")
+            archive = dict(entry, photo="archive/b.jpg")
+            (root / "set.json").write_text(json.dumps({"photos": [archive]}))
+            with self.assertRaisesRegex(RuntimeError, "archive/b.jpg is not under .*AMPI_PHOTO_ROOT"):
+                ordinal_data.load_split("val", root, root / "set.json")
 
 
     def test_teacher_labels_are_read_at_the_photos_size(self):
