@@ -153,6 +153,8 @@ def scaled_ordinal_set(ordinal: Path, sizes) -> dict:
     data = json.loads(Path(ordinal).read_text())
     photos = []
     for entry in data["photos"]:
+        if entry["photo"] not in sizes:
+            raise SystemExit(photo_folder.missing_photo(ordinal, entry["photo"], photo_folder.photo_root()))
         sx, sy, w, h = sizes[entry["photo"]]
 
         def scaled(point):  # pixel centres scaled, kept inside the carried photo

@@ -19,6 +19,7 @@ import torch.nn.functional as F
 from PIL import Image, ImageOps
 
 import distill
+import photo_folder
 
 ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json"
 PHOTO_MAX_SIDE = 640      # photos are kept decoded at this size (training crops are smaller)
@@ -55,10 +56,7 @@ def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE, 
             continue
         path = Path(photo_root) / entry["photo"]
         if not path.is_file():
-            raise RuntimeError(f"{ordinal_file}: {entry['photo']} is not under {photo_root}"
-                               + (" (the archive photos: run training/archive_photos.py and set "
-                                  "AMPI_PHOTO_ROOT=training/data_cache/photos)"
-                                  if entry["photo"].startswith("archive/") else ""))
+            raise RuntimeError(photo_folder.missing_photo(ordinal_file, entry["photo"], photo_root))
         with Image.open(path) as image:
             image = ImageOps.exif_transpose(image).convert("RGB")
         if image.size != (entry["width"], entry["height"]):
@@ -178,7 +176,6 @@ def labels_whdr(labels, split: str, photo_root: Path, ordinal_file: Path = ORDIN
 
 def main(argv=None):
     import argparse
-    import photo_folder
     p = argparse.ArgumentParser(description="WHDR of an `ampi distill` label folder on the ordinal set: "
                                             "/usr/bin/python3 training/ordinal_data.py LABELS [--split test]")
     p.add_argument("labels", help="an ampi distill label folder of the photo folder")

@@ -73,6 +73,14 @@ def photo_root():
     return Path(os.environ.get('AMPI_PHOTO_ROOT', DEFAULT_PHOTO_ROOT))
 
 
+def missing_photo(source, photo, root):
+    """The one-line error for a photo that source names and root lacks: for an archive
+    photo, how to make the root that holds it."""
+    hint = (' (the archive photos: run training/archive_photos.py and set '
+            'AMPI_PHOTO_ROOT=training/data_cache/photos)' if Path(photo).parent.name in TRAINING_ONLY_FOLDERS else '')
+    return f'{source}: {photo} is not under {root}{hint}'
+
+
 def image_files(root):
     """Every photo under root, sorted, linked folders followed (training/archive_photos.py's
     root links ../shared's folders)."""
