@@ -76,8 +76,10 @@ def photo_root():
 def missing_photo(source, photo, root):
     """The one-line error for a photo that source names and root lacks: for an archive
     photo, how to make the root that holds it."""
-    hint = (' (the archive photos: run training/archive_photos.py and set '
-            'AMPI_PHOTO_ROOT=training/data_cache/photos)' if Path(photo).parent.name in TRAINING_ONLY_FOLDERS else '')
+    hint = ''
+    if Path(photo).parent.name in TRAINING_ONLY_FOLDERS:
+        hint = (' (the archive photos: run training/archive_photos.py and set '
+                'AMPI_PHOTO_ROOT=training/data_cache/photos)')
     return f'{source}: {photo} is not under {root}{hint}'
 
 
