@@ -35,7 +35,6 @@ import photo_folder  # noqa: E402
 HERE = Path(__file__).resolve().parent
 CACHE = HERE / 'data_cache'
 ROOT = CACHE / 'photos'
-ARCHIVE_FOLDER = 'archive'
 MAX_SIDE = 2048   # as ../shared's debian folder
 
 # package: (folder inside it, prefix of the names here, photos, licence)
@@ -68,8 +67,8 @@ def archive_names():
 def link_shared_folders(shared: Path):
     ROOT.mkdir(parents=True, exist_ok=True)
     for folder in sorted(p for p in shared.iterdir() if p.is_dir()):
-        if folder.name == ARCHIVE_FOLDER:
-            raise SystemExit(f'{shared}: has a folder named {ARCHIVE_FOLDER}, the name kept for archive photos')
+        if folder.name == photo_folder.ARCHIVE_FOLDER:
+            raise SystemExit(f'{shared}: has a folder named {folder.name}, the name kept for archive photos')
         link = ROOT / folder.name
         if not link.is_symlink():
             link.symlink_to(folder.resolve(), target_is_directory=True)
@@ -96,7 +95,7 @@ def save_downscaled(source: Path, target: Path):
 
 
 def fetch_archive_photos():
-    out = ROOT / ARCHIVE_FOLDER
+    out = ROOT / photo_folder.ARCHIVE_FOLDER
     out.mkdir(parents=True, exist_ok=True)
     missing = {name: where for name, where in archive_names().items() if not (out / name).exists()}
     with tempfile.TemporaryDirectory() as tmp:

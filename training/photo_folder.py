@@ -22,7 +22,8 @@ VALIDATION_PHOTO_PERIOD = 10      # every tenth photo of a folder (by sorted nam
 ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validation (training/ordinal)
 # Folders whose photos are all training photos: training/archive_photos.py's, added after
 # the splits were fixed, so that validation and test stay the photos they were.
-TRAINING_ONLY_FOLDERS = {'archive'}
+ARCHIVE_FOLDER = 'archive'
+TRAINING_ONLY_FOLDERS = {ARCHIVE_FOLDER}
 
 
 def is_validation_seed(seed):
