@@ -30,8 +30,9 @@ area-shrunk to 320 px, so the two label sets differ by what the 384-px JPEG lose
 The runs train side by side on the one GPU, the machine's cores shared out equally among
 their DataLoader workers (scenes for depth, crops and their prefill for inpainting); the
 GPU outruns the scene renderer, so each depth scene batch trains --scene-reuse steps
-(augmented after the first). --minutes stops each run validated and checkpointed inside
-the command's limit; depth validation measures an exponential moving average of the
+(augmented after the first). --minutes stops each run validated and checkpointed; train.sh
+cuts it shorter when the teacher's labels have left less of the call (--call-seconds, the
+device tool's limit) than the training, the last validation and the hand-back need; depth validation measures an exponential moving average of the
 weights (--ema); --lr-decay cosine --decay-steps N gives the depth runs a learning rate
 that falls with the step (train_depth.cosine_lr) instead of x0.2 on a plateau.
 
@@ -70,6 +71,7 @@ ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
 INPAINT = "inpaint"
 TEACHER_LABELS = "teacher"   # the teacher's label folder under the carried folder, made there
 NETWORKS = (*depth_model.ARCHITECTURES, INPAINT)   # what --run NAME:DIR may name
+HANDBACK_SECONDS = 60   # of a device call: the last validation, the slim checkpoints, the logs
 INPAINT_ARGS = "--batch 32 --crop 96 --lr-g 4e-4 --lr-d 2e-4 --validate-every 250 --checkpoint-every 250"
 
 
@@ -203,7 +205,7 @@ def depth_command(args, model: str, workers: int) -> str:
             f"--size {args.size} --batch {args.batch} --init weights/depth_{model}.ampw --steps 10000000 "
             f"--device {args.device} --threads {args.threads} --workers {workers} --scene-reuse {args.scene_reuse} "
             f"--ema {args.ema}{lr}{decay} "
-            f"--minutes {args.minutes} --val-every {args.val_every} --val-count {args.val_count} "
+            f"--minutes $minutes --val-every {args.val_every} --val-count {args.val_count} "
             f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
             f"--rank-weight {args.rank_weight:g}"
             + (f" --teacher-labels {c}/{TEACHER_LABELS} --teacher-weight {args.teacher_weight:g}" if args.teacher else ""))
@@ -226,20 +228,27 @@ def inpaint_command(args, workers: int) -> str:
     c = args.carry
     return (f"{args.python} training/train_inpaint.py --run-dir {c}/{INPAINT} --photos {c}/photos "
             f"--planes-dir {c}/inpaint_planes --init weights/inpaint.ampw --perceptual weights/depth_lite.ampw "
-            f"--device {args.device} --threads {args.threads} --workers {workers} --minutes {args.minutes} "
+            f"--device {args.device} --threads {args.threads} --workers {workers} --minutes $minutes "
             f"{shlex.join(shlex.split(args.inpaint_args))}")
 
 
 def train_script(args, names, teacher_weights) -> str:
     """The shell script the GPU machine runs from the repository's root: the teacher's
     labels first (with --teacher), then every run's training side by side, then its slim
-    checkpoint, best weights and logs into $OUT/NAME/."""
+    checkpoint, best weights and logs into $OUT/NAME/. The training gets --minutes or
+    what the call has left after the teacher and before the hand-back, whichever is less:
+    a call the device tool stops at its limit brings nothing back."""
     c, workers = args.carry, max(1, args.workers // len(names))
     lines = ["#!/bin/bash", "# written by training/gpu_run.py pack", "set -u",
-             f"export AMPI_PHOTO_ROOT={c}/photos PYTHONUNBUFFERED=1", "pids=()"]
+             f"export AMPI_PHOTO_ROOT={c}/photos PYTHONUNBUFFERED=1", "pids=()",
+             f"deadline=$(( $(date +%s) + {args.call_seconds - HANDBACK_SECONDS} ))"]
     if teacher_weights:
         lines.append(f"{teacher_command(args, teacher_weights)} > {c}/teacher.txt 2>&1 "
                      f"|| {{ tail -n 20 {c}/teacher.txt; exit 1; }}")
+    lines += [f"minutes=$(awk -v cap={args.minutes:g} -v left=$(( deadline - $(date +%s) )) "
+              "'BEGIN { m = left / 60; if (m > cap) m = cap; printf \"%.2f\", m }')",
+              "awk \"BEGIN { exit !($minutes > 0) }\" || { echo \"train.sh: no time left to train\"; exit 1; }",
+              "echo \"train.sh: training for $minutes minutes\""]
     for name in names:
         command = inpaint_command(args, workers) if name == INPAINT else depth_command(args, name, workers)
         lines.append(f"{command} > {c}/{name}/console.txt 2>&1 & pids+=($!)")
@@ -262,6 +271,9 @@ def cmd_pack(args):
     carry, runs = Path(args.carry), parse_runs(args.run)
     if args.lr_decay == "cosine" and args.decay_steps <= 0:
         raise SystemExit("gpu_run.py pack: --lr-decay cosine needs --decay-steps N (N > 0)")
+    if args.call_seconds <= HANDBACK_SECONDS:
+        raise SystemExit(f"gpu_run.py pack: --call-seconds {args.call_seconds} leaves no time to train "
+                         f"(the hand-back takes {HANDBACK_SECONDS})")
     if args.teacher and all(name == INPAINT for name, _ in runs):
         raise SystemExit("gpu_run.py pack: --teacher labels photos for depth runs; give a --run lite:DIR or heavy:DIR")
     if carry.exists():
@@ -363,6 +375,9 @@ def main(argv=None):
     pack.add_argument("--workers", type=int, default=15,
                       help="batch-making processes, shared out equally among the runs (the machine has 16 cores)")
     pack.add_argument("--minutes", type=float, default=8.0, help="training time of one device run")
+    pack.add_argument("--call-seconds", type=int, default=600,
+                      help="the device call's limit (its timeout_s): train.sh trains less when the teacher "
+                           f"leaves less than --minutes plus {HANDBACK_SECONDS} s for the hand-back")
     depth = pack.add_argument_group("depth runs")
     depth.add_argument("--scene-reuse", type=int, default=4, help="steps each rendered scene batch trains")
     depth.add_argument("--ema", type=float, default=0.999,

@@ -182,6 +182,27 @@ class RoundTrip(unittest.TestCase):
             self.assertRegex(message, r"photos \d+\.\d,")   # each part named, with its size
             self.assertNotIn("\n", message)
 
+    def test_the_training_ends_before_the_call_does(self):
+        """train.sh trains --minutes, or less when the call's limit (--call-seconds) leaves
+        less before the hand-back; `echo` stands in for Python, so its console shows the
+        command line each run was given."""
+        with tempfile.TemporaryDirectory() as folder:
+            tmp = Path(folder)
+            make_photos(tmp)
+            env = dict(os.environ, AMPI_PHOTO_ROOT=str(tmp / "photos"), OUT=str(tmp / "out"))
+            for call_seconds, longest in ((600, 5.0), (gpu_run.HANDBACK_SECONDS + 6, 0.1)):
+                self.run_tool("pack", "--run", f"lite:{tmp / 'lite'}", "--carry", str(tmp / "carry"), "--ordinal",
+                              str(tmp / "ordinal.json"), "--python", "echo", "--minutes", "5",
+                              "--call-seconds", str(call_seconds), env=env)
+                done = subprocess.run(["bash", str(tmp / "carry" / "train.sh")], cwd=ROOT, env=env,
+                                      capture_output=True, text=True)
+                self.assertEqual(done.returncode, 0, done.stdout + done.stderr)
+                given = re.search(r"--minutes (\S+)", (tmp / "carry" / "lite" / "console.txt").read_text())
+                self.assertTrue(0 < float(given[1]) <= longest and float(given[1]) > longest - 0.05, given[1])
+            with contextlib.redirect_stdout(io.StringIO()), self.assertRaisesRegex(SystemExit, "no time to train"):
+                gpu_run.main(["pack", "--run", f"lite:{tmp / 'lite'}", "--carry", str(tmp / "carry"),
+                              "--call-seconds", str(gpu_run.HANDBACK_SECONDS)])
+
     def test_a_bundled_teacher_travels_with_the_tree_any_other_is_carried(self):
         with tempfile.TemporaryDirectory() as folder:
             tmp = Path(folder)
