@@ -1,4 +1,5 @@
-"""Tests of the validation metrics logged by train_depth.py (aligned_metrics)."""
+"""Tests of the validation metrics logged by train_depth.py (aligned_metrics) and of the
+depth losses (losses.py)."""
 import sys
 import unittest
 from pathlib import Path
@@ -6,6 +7,7 @@ from pathlib import Path
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import losses  # noqa: E402
 import train_depth  # noqa: E402
 
 
@@ -35,6 +37,29 @@ class AlignedMetricsTest(unittest.TestCase):
         self.assertLessEqual(m["delta1.25"], m["delta1.25^2"])
         self.assertLessEqual(m["delta1.25^2"], m["delta1.25^3"])
         self.assertLess(m["delta1.25"], 1.0)
+
+
+class DepthLossTest(unittest.TestCase):
+    def outputs(self, disparity):
+        """The network's four outputs for a prediction equal to `disparity`."""
+        return [torch.nn.functional.avg_pool2d(disparity, 2 ** s) if s else disparity for s in (3, 2, 1, 0)]
+
+    def test_the_invariant_loss_ignores_scale_and_shift_the_paper_loss_does_not(self):
+        target = ramp_scene(2)
+        affine = self.outputs(3.0 * target + 5.0)
+        self.assertLess(float(losses.depth_loss(affine, target, invariant=True)[0]), 1e-4)
+        self.assertGreater(float(losses.depth_loss(affine, target)[0]), 1.0)
+        self.assertLess(float(losses.depth_loss(self.outputs(losses.normalise_target(target)), target)[0]), 1e-4)
+
+    def test_the_invariant_loss_sees_a_flipped_map(self):
+        target = ramp_scene(3)
+        self.assertGreater(float(losses.depth_loss(self.outputs(-target), target, invariant=True)[0]), 1.0)
+
+    def test_normalised_maps_have_median_zero_and_the_set_spread(self):
+        x = losses.normalise_median_mad(ramp_scene(4) ** 2)
+        for image in x.flatten(1):
+            self.assertAlmostEqual(float(image.median()), 0.0, places=5)
+            self.assertAlmostEqual(float(image.abs().mean()), losses.INVARIANT_SPREAD, places=4)
 
 
 class WeightAverageTest(unittest.TestCase):

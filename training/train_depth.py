@@ -284,14 +284,14 @@ def aligned_metrics(pred: torch.Tensor, target: torch.Tensor) -> dict:
 
 
 @torch.no_grad()
-def validate(model, batches, device="cpu"):
+def validate(model, batches, device="cpu", invariant=False):
     """(mean loss, mean metrics) over the fixed validation batches."""
     model.eval()
     total, metrics = 0.0, []
     for rgb, disp in batches:
         rgb, disp = rgb.to(device), disp.to(device)
         outputs = model(rgb)
-        loss, _ = losses.depth_loss(outputs, disp)
+        loss, _ = losses.depth_loss(outputs, disp, invariant)
         total += float(loss)
         metrics.append(list(aligned_metrics(outputs[-1], disp).values()))
     model.train()
@@ -381,17 +381,22 @@ def training_step(model, optimiser, batch, args):
     rgb, disp, real_rgb, pairs, real_teacher = batch
     rgb, disp = rgb.to(args.device, non_blocking=True), disp.to(args.device, non_blocking=True)
     rank = taught = torch.zeros(())
+    invariant = args.loss == "invariant"
     if real_rgb is None:
-        loss, parts = losses.depth_loss(model(rgb), disp)
+        loss, parts = losses.depth_loss(model(rgb), disp, invariant)
     else:  # one pass over both: the BatchNorms see real photos too
         real_rgb = real_rgb.to(args.device, non_blocking=True)
         pairs = [(points.to(args.device), signs.to(args.device)) for points, signs in pairs]
         outputs = model(torch.cat([rgb, real_rgb]).contiguous(memory_format=torch.channels_last))
-        loss, parts = losses.depth_loss([o[:len(rgb)] for o in outputs], disp)
-        rank = ordinal_data.ranking_loss(outputs[-1][len(rgb):], pairs)
+        loss, parts = losses.depth_loss([o[:len(rgb)] for o in outputs], disp, invariant)
+        # the paper's loss holds the output's scale; without it the ranking loss, which
+        # falls as the scale grows, reads the output normalised too
+        real_disparity = outputs[-1][len(rgb):]
+        rank = ordinal_data.ranking_loss(losses.normalise_median_mad(real_disparity) if invariant else real_disparity,
+                                         pairs)
         loss = loss + args.rank_weight * rank
         if real_teacher is not None:  # the paper's loss on the real photos' pseudo ground truth
-            taught, _ = losses.depth_loss([o[len(rgb):] for o in outputs], real_teacher.to(args.device))
+            taught, _ = losses.depth_loss([o[len(rgb):] for o in outputs], real_teacher.to(args.device), invariant)
             loss = loss + args.teacher_weight * taught
     optimiser.zero_grad(set_to_none=True)
     loss.backward()
@@ -487,7 +492,8 @@ def train(args):
     ema = f", weights averaged (decay {args.ema:g})" if average else ""
     decay = (f" (cosine decay from {args.lr:.2e} to {args.lr * LR_FLOOR:.2e} at step {args.decay_steps})"
              if args.lr_decay == "cosine" else "")
-    log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data}{real} "
+    loss_note = ", scale- and shift-invariant loss" if args.loss == "invariant" else ""
+    log_line(run, f"train {args.model} ({depth_model.parameter_count(model)} parameters) on {args.data}{real}{loss_note} "
                   f"at {size[0]}x{size[1]}, batch {args.batch}, lr {optimiser.param_groups[0]['lr']:.2e}{decay}{ema}, "
                   f"{args.threads} threads, {args.workers} workers")
 
@@ -502,7 +508,7 @@ def train(args):
 
     def validation():
         nonlocal best
-        val_loss, metrics = validate(measured, val_batches, args.device)
+        val_loss, metrics = validate(measured, val_batches, args.device, args.loss == "invariant")
         if args.lr_decay == "none":
             scheduler.step(val_loss)
         whdr = validate_ordinal(measured, ordinal_val, max(size), args.device) if ordinal_val else None
@@ -586,6 +592,9 @@ def main(argv=None):
                                      "training photos, WHDR on its validation photos")
     p.add_argument("--ordinal-batch", type=int, default=4, help="real photos per step with --ordinal")
     p.add_argument("--rank-weight", type=float, default=1.0, help="weight of the ranking loss")
+    p.add_argument("--loss", choices=("paper", "invariant"), default="paper",
+                   help="paper: the target min-max normalised to [0, 10]; invariant: target and output "
+                        "normalised by median and mean absolute deviation (losses.py)")
     p.add_argument("--teacher-labels", help="an `ampi distill` label folder of the photo folder: the paper's "
                                             "loss on the --ordinal training photos' labels too (self-distillation)")
     p.add_argument("--teacher-weight", type=float, default=1.0, help="weight of the loss on --teacher-labels")
