@@ -32,9 +32,10 @@ their DataLoader workers (scenes for depth, crops and their prefill for inpainti
 GPU outruns the scene renderer, so each depth scene batch trains --scene-reuse steps
 (augmented after the first). --minutes stops each run validated and checkpointed; train.sh
 cuts it shorter when the teacher's labels have left less of the call (--call-seconds, the
-device tool's limit) than the training, the last validation and the hand-back need; depth validation measures an exponential moving average of the
-weights (--ema); --lr-decay cosine --decay-steps N gives the depth runs a learning rate
-that falls with the step (train_depth.cosine_lr) instead of x0.2 on a plateau.
+device tool's limit) than the training, the last validation and the hand-back need. Depth
+validation measures an exponential moving average of the weights (--ema); --lr-decay
+cosine --decay-steps N gives the depth runs a learning rate that falls with the step
+(train_depth.cosine_lr) instead of x0.2 on a plateau.
 
 Checkpoints cross slim, without Adam's moments (a returned file may have 16 MiB, all of
 them 64 MiB). A depth checkpoint carries the average as the weights, in half precision
