@@ -208,7 +208,7 @@ def depth_command(args, model: str, workers: int) -> str:
             f"--ema {args.ema}{lr}{decay} "
             f"--minutes $minutes --val-every {args.val_every} --val-count {args.val_count} "
             f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
-            f"--rank-weight {args.rank_weight:g}"
+            f"--rank-weight {args.rank_weight:g} --loss {args.loss}"
             + (f" --teacher-labels {c}/{TEACHER_LABELS} --teacher-weight {args.teacher_weight:g}" if args.teacher else ""))
 
 
@@ -390,6 +390,7 @@ def main(argv=None):
     depth.add_argument("--decay-steps", type=int, default=0,
                        help="with --lr-decay cosine: the step (from the run's start) where lr reaches its floor")
     depth.add_argument("--val-count", type=int, default=32)
+    depth.add_argument("--loss", choices=("paper", "invariant"), default="paper", help="train_depth.py --loss")
     depth.add_argument("--size", default="256x192")
     depth.add_argument("--batch", type=int, default=48)
     depth.add_argument("--ordinal-batch", type=int, default=16)
