@@ -5,15 +5,15 @@
     L_grad  = sum_{s=0..3} mean |grad_x(y^_s - y_s)| + mean |grad_y(y^_s - y_s)|
 
 where y is the target disparity normalised per image to [0, 10] and brought to the
-output's resolution, and y^_s, y_s are prediction and target down-scaled by 2^s.
+output's resolution, and y^_s, y_s are prediction and target down-scaled by 2^s. The
+down-scaling is a 2^s x 2^s average (area) pooling; since it is linear, pooling the
+difference equals the difference of the pooled maps. A scale whose map would be smaller
+than 2 pixels on a side has no gradient to measure and is skipped (only on tiny inputs).
 
 invariant=True (train_depth.py --loss invariant, ours, not the paper's) puts both y^ and
 y through normalise_median_mad first, as MiDaS does (Ranftl et al. 2020, "scale- and
 shift-invariant losses"): the network no longer has to guess where the nearest pixel of
-a scene lies, which the [0, 10] target asks of it. The
-down-scaling is a 2^s x 2^s average (area) pooling; since it is linear, pooling the
-difference equals the difference of the pooled maps. A scale whose map would be smaller
-than 2 pixels on a side has no gradient to measure and is skipped (only on tiny inputs).
+a scene lies, which the [0, 10] target asks of it.
 """
 from __future__ import annotations
 
@@ -23,9 +23,9 @@ import torch.nn.functional as F
 GRAD_WEIGHT = 0.5
 GRAD_SCALES = 4
 TARGET_RANGE = 10.0
-# the mean absolute deviation normalise_median_mad brings maps to, about that of a target
-# normalised to [0, TARGET_RANGE], so that the weights of the losses beside it keep their sense
-INVARIANT_SPREAD = 2.25   # the median over the 50 synthetic validation scenes
+# the mean absolute deviation normalise_median_mad brings maps to: about that of a synthetic
+# scene's target normalised to [0, TARGET_RANGE], so the weights of the losses beside it keep their sense
+INVARIANT_SPREAD = 2.25
 
 
 def normalise_target(disparity: torch.Tensor, eps: float = 1e-6) -> torch.Tensor:
