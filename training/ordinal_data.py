@@ -24,6 +24,7 @@ import photo_folder
 ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json"
 PHOTO_MAX_SIDE = 640      # photos are kept decoded at this size (training crops are smaller)
 CROP_SHARE = (0.7, 1.0)   # a training crop keeps this share of each side
+WIDE_CROP_SHARE = (0.5, 1.0)  # train_depth.py --photo-augment: more zoom, more views of few photos
 
 
 class OrdinalPhoto:
@@ -97,13 +98,13 @@ def _resize_map(disparity: np.ndarray, size):
     return np.array(Image.fromarray(disparity, mode="F").resize(size, Image.BILINEAR, reducing_gap=2.0))
 
 
-def training_sample(photo: OrdinalPhoto, size, rng: random.Random):
-    """A random crop (CROP_SHARE of each side), resized to size = (w, h), flipped half the
+def training_sample(photo: OrdinalPhoto, size, rng: random.Random, crop_share=CROP_SHARE):
+    """A random crop (crop_share of each side), resized to size = (w, h), flipped half the
     time: (rgb [3, h, w] float in [0, 1], points [P, 2, 2] in its pixels, signs [P],
     the teacher's label [1, h, w] cropped alike or None). Pairs with a point outside the
     crop are dropped."""
     H, W = photo.rgb.shape[:2]
-    cw, ch = round(W * rng.uniform(*CROP_SHARE)), round(H * rng.uniform(*CROP_SHARE))
+    cw, ch = round(W * rng.uniform(*crop_share)), round(H * rng.uniform(*crop_share))
     x0, y0 = rng.randint(0, W - cw), rng.randint(0, H - ch)
     rgb = _resize(photo.rgb[y0:y0 + ch, x0:x0 + cw], size)
     teacher = None if photo.teacher is None else _resize_map(photo.teacher[y0:y0 + ch, x0:x0 + cw], size)

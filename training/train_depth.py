@@ -23,10 +23,11 @@ Validation uses a disjoint fixed set: scene seeds from VAL_SEED_START, or every 
 pair by sorted name (never trained on).
 
 Real photos (--ordinal training/ordinal/ordinal.json): each step also takes
---ordinal-batch photos of the set's training split (random crops, flips) with the
-ranking loss of their labelled pairs (training/ordinal_data.py), weighted by
---rank-weight, beside the paper's loss on the synthetic batch; every validation also
-measures WHDR on the set's validation photos, and best.pt is then the best WHDR.
+--ordinal-batch photos of the set's training split (random crops, flips; wider crops
+and colour jitter with --photo-augment) with the ranking loss of their labelled pairs
+(training/ordinal_data.py), weighted by --rank-weight, beside the paper's loss on the
+synthetic batch; every validation also measures WHDR on the set's validation photos,
+and best.pt is then the best WHDR.
 --teacher-labels LABELS (an `ampi distill` folder of the photo folder) adds the paper's
 loss on those photos' pseudo ground truth, cropped and flipped with them and weighted by
 --teacher-weight: the paper's self-distillation, beside the scenes and the pairs.
@@ -206,9 +207,12 @@ class TrainingBatches(torch.utils.data.Dataset):
         or None)."""
         if not self.ordinal_photos:
             return None, [], None
-        samples = [ordinal_data.training_sample(rng.choice(self.ordinal_photos), self.size, rng)
+        augment = self.args.photo_augment
+        crop_share = ordinal_data.WIDE_CROP_SHARE if augment else ordinal_data.CROP_SHARE
+        samples = [ordinal_data.training_sample(rng.choice(self.ordinal_photos), self.size, rng, crop_share)
                    for _ in range(self.args.ordinal_batch)]
-        real = torch.stack([s[0] for s in samples]).contiguous(memory_format=torch.channels_last)
+        images = [jitter_colour(s[0], rng) if augment else s[0] for s in samples]
+        real = torch.stack(images).contiguous(memory_format=torch.channels_last)
         teacher = torch.stack([s[3] for s in samples]) if samples[0][3] is not None else None
         return real, [(s[1], s[2]) for s in samples], teacher
 
@@ -243,11 +247,15 @@ def augment_scene_batch(rgb: torch.Tensor, disp: torch.Tensor, rng: random.Rando
                                align_corners=False)[0]
         if rng.random() < 0.5:
             image, target = image.flip(-1), target.flip(-1)
-        gain = torch.tensor([rng.uniform(*COLOUR_GAIN) for _ in range(3)], device=rgb.device).view(3, 1, 1)
-        image = (image.clamp(0, 1) ** rng.uniform(*GAMMA) * gain).clamp(0, 1)
-        rgbs.append(image)
+        rgbs.append(jitter_colour(image, rng))
         disps.append(target)
     return torch.stack(rgbs).contiguous(memory_format=torch.channels_last), torch.stack(disps)
+
+
+def jitter_colour(image: torch.Tensor, rng: random.Random) -> torch.Tensor:
+    """image [3, h, w] in [0, 1] under a random gamma and a random gain per colour channel."""
+    gain = torch.tensor([rng.uniform(*COLOUR_GAIN) for _ in range(3)], device=image.device).view(3, 1, 1)
+    return (image.clamp(0, 1) ** rng.uniform(*GAMMA) * gain).clamp(0, 1)
 
 
 def _worker_init(_):
@@ -487,7 +495,7 @@ def train(args):
     teacher_note = (f", teacher's labels {args.teacher_labels} weight {args.teacher_weight:g}"
                     if args.teacher_labels else "")
     real = (f" + {args.ordinal_batch} real photos ({len(ordinal_train)} with pairs, rank weight {args.rank_weight:g}"
-            f"{teacher_note})"
+            f"{teacher_note}{', wide crops and colour jitter' if args.photo_augment else ''})"
             if ordinal_train else "")
     ema = f", weights averaged (decay {args.ema:g})" if average else ""
     decay = (f" (cosine decay from {args.lr:.2e} to {args.lr * LR_FLOOR:.2e} at step {args.decay_steps})"
@@ -592,6 +600,9 @@ def main(argv=None):
                                      "training photos, WHDR on its validation photos")
     p.add_argument("--ordinal-batch", type=int, default=4, help="real photos per step with --ordinal")
     p.add_argument("--rank-weight", type=float, default=1.0, help="weight of the ranking loss")
+    p.add_argument("--photo-augment", action="store_true",
+                   help="the real photos' crops keep 50-100%% of each side (70-100%% without) and take the "
+                        "scenes' colour jitter: more distinct views of the few training photos")
     p.add_argument("--loss", choices=("paper", "invariant"), default="paper",
                    help="paper: the target min-max normalised to [0, 10]; invariant: target and output "
                         "normalised by median and mean absolute deviation (losses.py)")
