@@ -1,5 +1,6 @@
 """Tests of training/ordinal_data.py: the ranking loss, WHDR, the crops' point mapping,
 and reading an ordinal set."""
+import itertools
 import json
 import random
 import sys
@@ -57,8 +58,8 @@ class Crops(unittest.TestCase):
         points = np.array([[[17.0, 33.0], [300.0, 200.0]], [[160.0, 120.0], [40.0, 220.0]]], np.float32)
         teacher = np.mgrid[0:240, 0:320][1].astype(np.float32) / 320  # a label rising to the right
         photo = ordinal_data.OrdinalPhoto(rgb, points, np.array([1.0, -1.0], np.float32), teacher)
-        for seed in range(20):
-            image, mapped, signs, label = ordinal_data.training_sample(photo, (64, 48), random.Random(seed))
+        for seed, share in itertools.product(range(20), (ordinal_data.CROP_SHARE, ordinal_data.WIDE_CROP_SHARE)):
+            image, mapped, signs, label = ordinal_data.training_sample(photo, (64, 48), random.Random(seed), share)
             self.assertEqual(tuple(image.shape), (3, 48, 64))
             self.assertEqual(tuple(label.shape), (1, 48, 64))
             for pair, sign in zip(mapped, signs):
@@ -151,6 +152,16 @@ class Labelling(unittest.TestCase):
         self.assertEqual(pairs.split_parts("val", test_round), [("test", test_round)])
         self.assertEqual(pairs.split_parts("train", first + test_round), [("train", first + test_round)])
         self.assertEqual(pairs.split_parts("train", []), [])
+
+    def test_a_gzip_pair_file_reads_back_and_is_the_same_bytes_every_time(self):
+        photos = [{"photo": "kodak24/a.png", "width": 4, "height": 3, "split": "train",
+                   "pairs": [{"id": 1, "kind": "random", "a": [0.5, 1.0], "b": [3.0, 2.5]}]}]
+        with tempfile.TemporaryDirectory() as tmp:
+            first, second = Path(tmp) / "one.json.gz", Path(tmp) / "two.json.gz"
+            pairs.write_set(first, {"seed": 1}, photos)
+            pairs.write_set(second, {"seed": 1}, photos)
+            self.assertEqual(pairs.read_pairs(first), photos)
+            self.assertEqual(first.read_bytes(), second.read_bytes())
 
     def test_an_order_is_kept_only_when_every_labeller_gave_it(self):
         self.assertEqual(pairs.consensus(["A"]), "A")

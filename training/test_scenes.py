@@ -4,15 +4,18 @@
 Run: /usr/bin/python3 training/test_scenes.py (ctest runs it as training_scenes)."""
 
 import os
+import struct
 import sys
 import tempfile
 import unittest
+import zlib
 from pathlib import Path
 
 import numpy as np
 import torch
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import archive_photos  # noqa: E402
 import photo_folder  # noqa: E402
 import raytracer  # noqa: E402
 import scene_sampler  # noqa: E402
@@ -268,6 +271,50 @@ class ValidationSplit(unittest.TestCase):
             for split in (photo_folder.photo_split, photo_folder.ordinal_split):
                 self.assertEqual([split(p) for p in linked], [split(shared / 'kodak24' / p.name) for p in linked])
                 self.assertEqual({split(p) for p in photos if p.parent.name == 'archive'}, {'train'})
+
+    def test_a_qt_resource_file_gives_back_its_files(self):
+        """archive_photos.read_rcc on a version-3 resource file built here by the format: a
+        folder holding a zlib-compressed file, a stored one and a zstd one (left out)."""
+        names, tree, data = b'', b'', b''
+
+        def name(text):
+            nonlocal names
+            offset = len(names)
+            names += struct.pack('>HI', len(text), 0) + text.encode('utf-16-be')
+            return offset
+
+        def stored(content, compress=False):
+            nonlocal data
+            offset = len(data)
+            body = struct.pack('>I', len(content)) + zlib.compress(content) if compress else content
+            data += struct.pack('>I', len(body)) + body
+            return offset
+
+        def folder(name_offset, count, first):
+            return struct.pack('>IHII', name_offset, 2, count, first) + bytes(8)
+
+        def file(name_offset, flags, offset):
+            return struct.pack('>IHHHI', name_offset, flags, 0, 0, offset) + bytes(8)
+
+        photo = bytes(range(256)) * 4
+        tree = (folder(0, 1, 1) + folder(name('res'), 3, 2) + file(name('a.webp'), 1, stored(photo, True))
+                + file(name('b.txt'), 0, stored(b'plain')) + file(name('c.bin'), 4, stored(b'zstd')))
+        header_size = 24
+        blob = (b'qres' + struct.pack('>5I', 3, header_size, header_size + len(tree),
+                                      header_size + len(tree) + len(data), 0) + tree + data + names)
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / 'one.rcc'
+            path.write_bytes(blob)
+            self.assertEqual(archive_photos.read_rcc(path), {'res/a.webp': photo, 'res/b.txt': b'plain'})
+            path.write_bytes(b'PK' + blob[2:])
+            with self.assertRaisesRegex(SystemExit, 'one.rcc: not a Qt resource file'):
+                archive_photos.read_rcc(path)
+
+    def test_archive_names_are_unique_photos(self):
+        names = archive_photos.archive_names()
+        self.assertEqual(len(names), sum(len(photos) for *_, photos, _licence in archive_photos.SOURCES))
+        self.assertTrue(all(Path(name).suffix in photo_folder.PHOTO_SUFFIXES for name in names))
+        self.assertEqual(archive_photos.name_here('usa/navajo.webp'), ('usa/navajo.webp', 'usa_navajo.jpg'))
 
     def test_bad_paths_are_named_in_the_error(self):
         with self.assertRaisesRegex(ValueError, 'notes.txt'):

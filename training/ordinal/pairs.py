@@ -3,7 +3,7 @@
 them by eye, and the merged label file.
 
     export AMPI_PHOTO_ROOT=training/data_cache/photos  # ../shared's photos and the archive's
-    /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json
+    /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json.gz
     /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--round N] [--only REL...]
     /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
 
@@ -23,6 +23,7 @@ upright (turned by its EXIF orientation, as `ampi` reads it; x right, y down).
 """
 
 import argparse
+import gzip
 import hashlib
 import json
 import math
@@ -36,7 +37,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 import photo_folder  # noqa: E402  (the photo listing and the split)
 
 HERE = Path(__file__).resolve().parent
-PAIRS_FILE = HERE / 'pairs.json'
+PAIRS_FILE = HERE / 'pairs.json.gz'   # gzip: it travels to GPU machines with the working tree
 LABELS_DIR = HERE / 'labels'
 ORDINAL_FILE = HERE / 'ordinal.json'
 
@@ -137,13 +138,23 @@ def sample_photo(path, rel):
 def write_set(path: Path, header: dict, photos: list):
     """header's keys and the photos as JSON, one pair per line: a third of the size of an
     indented dump (the set travels to GPU machines with the working tree, against a
-    transfer limit), and a label change is still a one-line diff."""
+    transfer limit), and a label change is still a one-line diff. A path ending in .gz is
+    compressed (with no time stamp, so the same set makes the same bytes)."""
     lines = [f' {json.dumps(k)}: {json.dumps(v)},' for k, v in header.items()] + [' "photos": [']
     for n, entry in enumerate(photos):
         fields = json.dumps({k: v for k, v in entry.items() if k != 'pairs'})[:-1]
         pairs = ',\n'.join(f'   {json.dumps(pair)}' for pair in entry['pairs'])
         lines.append(f'  {fields}, "pairs": [\n{pairs}\n  ]}}' + (',' if n + 1 < len(photos) else ''))
-    path.write_text('{\n' + '\n'.join(lines) + '\n ]\n}\n')
+    text = '{\n' + '\n'.join(lines) + '\n ]\n}\n'
+    if path.suffix == '.gz':
+        path.write_bytes(gzip.compress(text.encode(), mtime=0))
+    else:
+        path.write_text(text)
+
+
+def read_pairs(path: Path = PAIRS_FILE) -> list:
+    """The photos of a pair file (PAIRS_FILE), each with its pairs."""
+    return json.loads(gzip.decompress(path.read_bytes()))['photos']
 
 
 def cmd_sample(args):
@@ -217,7 +228,7 @@ def cmd_draw(args):
     root = photo_folder.photo_root()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    entries = json.loads(PAIRS_FILE.read_text())['photos']
+    entries = read_pairs()
     if args.only:
         entries = [e for e in entries if e['photo'] in set(args.only)]
     for entry in entries:
@@ -276,11 +287,11 @@ def split_parts(split, pairs):
 
 def cmd_merge(args):
     labels = read_labels(LABELS_DIR)
-    photos = json.loads(PAIRS_FILE.read_text())['photos']
+    photos = read_pairs()
     known = {(e['photo'], p['id']) for e in photos for p in e['pairs']}
     unknown = sorted(set(labels) - known)
     if unknown:
-        raise SystemExit(f'{LABELS_DIR}: labels for pairs that pairs.json does not have: {unknown[:3]}')
+        raise SystemExit(f'{LABELS_DIR}: labels for pairs that {PAIRS_FILE.name} does not have: {unknown[:3]}')
     merged = []
     for entry in photos:
         pairs = [dict(p, label=consensus(labels[(entry['photo'], p['id'])]),
@@ -304,7 +315,7 @@ def cmd_merge(args):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest='command', required=True)
-    sub.add_parser('sample', help='draw the pairs of every photo into pairs.json')
+    sub.add_parser('sample', help='draw the pairs of every photo into pairs.json.gz')
     d = sub.add_parser('draw', help='write the marked images to label')
     d.add_argument('--out', required=True)
     d.add_argument('--round', type=int, default=ROUNDS, choices=range(1, ROUNDS + 1),
