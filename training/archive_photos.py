@@ -47,6 +47,8 @@ CACHE = HERE / 'data_cache'
 ROOT = CACHE / 'photos'
 MAX_SIDE = 2048   # as ../shared's debian folder
 
+GCOMPRIS_LICENCE = 'per photo in its copyright file (CC-BY-SA, CC0, GPL)'
+
 # (package, folder inside it, prefix of the names here, photos, licence). A folder ending
 # in .rcc/... is a folder inside that Qt resource file of the package (read_rcc). A photo
 # is its path under the folder, or (that path, its name here); by default its name here is
@@ -83,7 +85,7 @@ SOURCES = [
          'dolphin', 'flying_fox', 'gibbon', 'giraffe', 'goat', 'gorilla', 'gosling', 'heron', 'horse',
          'kingfisher', 'kitten', 'long_nosed_monkey', 'macaque', 'meerkats', 'northern_harrier',
          'nubian_ibex', 'penguin', 'pika', 'red_panda', 'rhinoceros', 'spoonbills', 'squirrel', 'swans',
-         'toucan')], 'per photo in its copyright file (CC-BY-SA, CC0, GPL)'),
+         'toucan')], GCOMPRIS_LICENCE),
     ('gcompris-qt-data', 'usr/share/gcompris-qt/rcc/explore_monuments.rcc/gcompris/src/activities/'
      'explore_monuments/resource', 'gcompris_monuments', [f'{name}.webp' for name in (
          'egypt/bentPyramid', 'egypt/greatPyramidOfGiza', 'egypt/meidumPyramid', 'egypt/redPyramid',
@@ -99,22 +101,22 @@ SOURCES = [
          'usa/lincolnMemorial', 'usa/mountRushmore', 'usa/navajo', 'usa/statueofLiberty',
          'wonders/chichenItza', 'wonders/christTheRedeemer', 'wonders/colosseum', 'wonders/greatWallofChina',
          'wonders/machuPicchu', 'wonders/petra', 'wonders/tajMahal')],
-     'per photo in its copyright file (CC-BY-SA, CC0, GPL)'),
+     GCOMPRIS_LICENCE),
     ('gcompris-qt-data', 'usr/share/gcompris-qt/rcc/explore_farm_animals.rcc/gcompris/src/activities/'
      'explore_farm_animals/resource/animals', 'gcompris_farm', [f'{name}.webp' for name in (
          'cat', 'chicken', 'cow', 'dog', 'duck', 'horse', 'owl', 'pig', 'sheep')],
-     'per photo in its copyright file (CC-BY-SA, CC0, GPL)'),
+     GCOMPRIS_LICENCE),
     ('gcompris-qt-data', 'usr/share/gcompris-qt/rcc/explore_world_animals.rcc/gcompris/src/activities/'
      'explore_world_animals/resource/animals', 'gcompris_animals', [f'{name}.webp' for name in (
          'bison', 'chameleon', 'crocodile', 'dragon', 'giraffe', 'hedgehog', 'jaguar', 'kangaroo', 'koala',
          'lemur', 'moose', 'narwhal', 'panda', 'polar_bear', 'scarlet_macaw')],
-     'per photo in its copyright file (CC-BY-SA, CC0, GPL)'),
+     GCOMPRIS_LICENCE),
     ('gcompris-qt-data', 'usr/share/gcompris-qt/rcc/explore_world_music.rcc/gcompris/src/activities/'
      'explore_world_music/resource/music', 'gcompris_music', [f'{name}.webp' for name in (
          'africa', 'america', 'australia', 'ireland', 'italy', 'japan', 'mexico', 'middleeast', 'orchestra')],
-     'per photo in its copyright file (CC-BY-SA, CC0, GPL)'),
+     GCOMPRIS_LICENCE),
     ('gcompris-qt-data', 'usr/share/gcompris-qt/rcc/clickgame.rcc/gcompris/src/activities/clickgame/resource',
-     'gcompris_sea', [f'sea{k}.webp' for k in range(1, 7)], 'per photo in its copyright file (CC-BY-SA, CC0, GPL)'),
+     'gcompris_sea', [f'sea{k}.webp' for k in range(1, 7)], GCOMPRIS_LICENCE),
 ]
 
 
