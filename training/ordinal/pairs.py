@@ -6,6 +6,7 @@ them by eye, and the merged label file.
     /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json.gz
     /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--round N] [--only REL...]
     /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
+    /usr/bin/python3 training/ordinal/pairs.py subset OUT [--prefix archive/...] [--rounds 1-2]
 
 (training/archive_photos.py makes that root; `sample` from ../shared alone would leave the
 archive photos out.)
@@ -312,6 +313,27 @@ def cmd_merge(args):
           f'{same} alike, {opposite} with A against B')
 
 
+# ----------------------------------------------------------------------------------
+# A part of the merged set, for a WHDR of its own
+
+def subset(photos: list, prefixes, rounds) -> list:
+    """The entries of photos whose name starts with one of prefixes (all when none), each
+    keeping only its pairs of rounds (first, last); entries left empty are dropped."""
+    first, last = rounds
+    kept = [dict(e, pairs=[p for p in e['pairs'] if first <= round_of(p['id']) <= last])
+            for e in photos if not prefixes or e['photo'].startswith(tuple(prefixes))]
+    return [e for e in kept if e['pairs']]
+
+
+def cmd_subset(args):
+    whole = json.loads(ORDINAL_FILE.read_text())
+    first, _, last = args.rounds.partition('-')
+    photos = subset(whole['photos'], args.prefix, (int(first), int(last or first)))
+    write_set(Path(args.out), {k: v for k, v in whole.items() if k != 'photos'}, photos)
+    ordered = sum(p['label'] != '=' for e in photos for p in e['pairs'])
+    print(f'{args.out}: {len(photos)} photos, {ordered} ordered pairs')
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = ap.add_subparsers(dest='command', required=True)
@@ -322,8 +344,13 @@ def main():
                    help='which round of pairs to mark (default the newest)')
     d.add_argument('--only', nargs='*', help='photos (relative names) to draw, default all')
     sub.add_parser('merge', help='labels/*.tsv -> ordinal.json')
+    s = sub.add_parser('subset', help="a part of ordinal.json (some photos, some rounds) for `ampi eval depth --ordinal`")
+    s.add_argument('out')
+    s.add_argument('--prefix', action='append', default=[],
+                   help='keep the photos whose name starts with this (repeatable; default all)')
+    s.add_argument('--rounds', default=f'1-{ROUNDS}', help='keep these rounds: N or FIRST-LAST')
     args = ap.parse_args()
-    {'sample': cmd_sample, 'draw': cmd_draw, 'merge': cmd_merge}[args.command](args)
+    {'sample': cmd_sample, 'draw': cmd_draw, 'merge': cmd_merge, 'subset': cmd_subset}[args.command](args)
 
 
 if __name__ == '__main__':
