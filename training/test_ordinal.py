@@ -17,6 +17,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import ordinal_data  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parent / "ordinal"))
 import pairs  # noqa: E402
+import mirror_whdr  # noqa: E402
 
 
 def coordinate_photo(w, h):
@@ -50,6 +51,36 @@ class RankingAndWhdr(unittest.TestCase):
 
     def test_a_batch_without_pairs_costs_nothing(self):
         self.assertEqual(float(ordinal_data.ranking_loss(torch.zeros(2, 1, 4, 4), [])), 0.0)
+
+
+class Mirrored(unittest.TestCase):
+    """mirror_whdr.py: the mirrored run reads its disparity back in the photo's own frame."""
+
+    class Ramp:
+        """A stand-in network whose disparity grows along x (or y): [N, 1, H, W] as the last
+        of its outputs, like depth_model.DepthNet."""
+        multiple = 32
+
+        def __init__(self, axis):
+            self.axis = axis
+
+        def __call__(self, x):
+            n, _, h, w = x.shape
+            ramp = torch.arange(w if self.axis == "x" else h, dtype=torch.float32)
+            ramp = ramp.view(1, 1, 1, w) if self.axis == "x" else ramp.view(1, 1, h, 1)
+            return [ramp.expand(n, 1, h, w)]
+
+    def setUp(self):
+        rgb = np.random.default_rng(3).integers(0, 256, (90, 120, 3), dtype=np.uint8)
+        # A (right, low) nearer than B (left, high): right for both ramps as the photo is.
+        points = np.array([[[100.0, 80.0], [20.0, 10.0]]], np.float32)
+        self.photos = [ordinal_data.OrdinalPhoto(rgb, points, np.array([1.0], np.float32))]
+
+    def test_a_left_right_ramp_is_wrong_only_mirrored(self):
+        self.assertEqual(mirror_whdr.whdr_both_ways(self.Ramp("x"), self.photos, 64), (0.0, 1.0, 1))
+
+    def test_a_top_bottom_ramp_is_right_both_ways(self):
+        self.assertEqual(mirror_whdr.whdr_both_ways(self.Ramp("y"), self.photos, 64), (0.0, 0.0, 1))
 
 
 class Crops(unittest.TestCase):
