@@ -12,8 +12,9 @@ namespace ampi {
 // file's; DepthModel::set_working_size, which throws std::invalid_argument on a size the
 // network cannot take) on the photo resized to net.input_size() with the tent filter
 // its training used (tent_resize.h): the wavelet networks' long side at most the working
-// size, never upscaled; Depth Anything V2 the photo as it is (it resizes inside). Returns CV_32FC1 disparity (larger = nearer)
-// at that input size; callers resize it to whatever resolution they need.
+// size, never upscaled; Depth Anything V2 the photo as it is (it resizes inside).
+// Returns CV_32FC1 disparity (larger = nearer) at that input size; callers resize it to
+// whatever resolution they need.
 cv::Mat estimate_disparity(DepthModel& net, const cv::Mat& bgr, int working_size,
                            ThreadPool& pool = default_pool());
 

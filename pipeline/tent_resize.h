@@ -1,8 +1,7 @@
 // Downscaling with a tent (triangle) filter stretched by the reduction factor: the filter
 // the depth networks' training photos are shrunk with (PIL's antialiased bilinear resize,
-// training/ordinal_data.py). A network sees its training's blur: fed OpenCV's area
-// average instead, lite ordered about a point more of the ordinal pairs wrongly
-// (training/DEPTH.md, "The input filter").
+// training/ordinal_data.py), so that the engine runs each network on images as soft as
+// those it was trained and picked on (training/DEPTH.md, "The input filter").
 #pragma once
 #include <opencv2/core.hpp>
 
