@@ -6,8 +6,8 @@
 
 Each photo is run as the engine runs it (pipeline/depth_estimate.cpp: the long side brought
 to the file's working size by PIL's antialiased bilinear resize, the engine's tent filter;
-edge-replicated to the network's multiple), once as it is and once mirrored, the mirrored disparity
-mirrored back before the pairs are read. Every file was picked by its WHDR on `val` as the
+edge-replicated to the network's multiple), once as it is and once mirrored, the mirrored
+disparity mirrored back before the pairs are read. Every file was picked by its WHDR on `val` as the
 photos are (train_depth.py --ordinal), never mirrored, so the gap between the two columns
 on `val` and `test` is partly that choice; on photos no choice has seen it is the network's
 own left-right bias alone. The subset of ordinal.json for the photos no bundled file
@@ -31,19 +31,25 @@ import photo_folder  # noqa: E402
 from ampw import read_ampw  # noqa: E402
 
 
-def disparity_at_working_size(model, rgb: np.ndarray, long_side: int, mirrored: bool) -> torch.Tensor:
-    """The network's disparity [1, h, w] of rgb (full photo, uint8) at the engine's input
-    size, mirrored in and back out when asked."""
-    height, width = rgb.shape[:2]
+def engine_input(photo, long_side: int):
+    """(image [3, h, w] in [0, 1], points in its pixels): the full photo's long side
+    brought to long_side, aspect kept, never enlarged (nets/depth_model.cpp)."""
+    height, width = photo.rgb.shape[:2]
     scale = min(1.0, long_side / max(height, width))
     size = (max(1, round(width * scale)), max(1, round(height * scale)))
-    image = torch.from_numpy(np.asarray(Image.fromarray(rgb).resize(size, Image.BILINEAR)).copy())
-    image = image.permute(2, 0, 1).float() / 255.0
+    image = torch.from_numpy(np.asarray(Image.fromarray(photo.rgb).resize(size, Image.BILINEAR)).copy())
+    points = (photo.points + 0.5) * np.array([size[0] / width, size[1] / height], np.float32) - 0.5
+    return image.permute(2, 0, 1).float() / 255.0, torch.from_numpy(points)
+
+
+def disparity_of(model, image: torch.Tensor, mirrored: bool) -> torch.Tensor:
+    """The network's disparity [1, h, w] of image, mirrored in and back out when asked."""
+    height, width = image.shape[-2:]
     if mirrored:
         image = image.flip(-1)
-    padded = F.pad(image[None], (0, (-size[0]) % model.multiple, 0, (-size[1]) % model.multiple), mode="replicate")
+    padded = F.pad(image[None], (0, (-width) % model.multiple, 0, (-height) % model.multiple), mode="replicate")
     with torch.no_grad():
-        disparity = model(padded.contiguous(memory_format=torch.channels_last))[-1][0, :, :size[1], :size[0]]
+        disparity = model(padded.contiguous(memory_format=torch.channels_last))[-1][0, :, :height, :width]
     return disparity.flip(-1) if mirrored else disparity
 
 
@@ -52,14 +58,10 @@ def whdr_both_ways(model, photos, long_side: int):
     wrong = [0.0, 0.0]
     pairs = 0
     for photo in photos:
-        height, width = photo.rgb.shape[:2]
-        scale = min(1.0, long_side / max(height, width))
-        size = (max(1, round(width * scale)), max(1, round(height * scale)))
-        points = (photo.points + 0.5) * np.array([size[0] / width, size[1] / height], np.float32) - 0.5
+        image, points = engine_input(photo, long_side)
+        signs = torch.from_numpy(photo.signs)
         for i, mirrored in enumerate((False, True)):
-            disparity = disparity_at_working_size(model, photo.rgb, long_side, mirrored)
-            photo_wrong, photo_pairs = ordinal_data.whdr_counts(disparity, torch.from_numpy(points),
-                                                                torch.from_numpy(photo.signs))
+            photo_wrong, photo_pairs = ordinal_data.whdr_counts(disparity_of(model, image, mirrored), points, signs)
             wrong[i] += photo_wrong
         pairs += photo_pairs
     return wrong[0] / max(pairs, 1), wrong[1] / max(pairs, 1), pairs
