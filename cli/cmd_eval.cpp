@@ -154,7 +154,8 @@ int eval_inpaint(int argc, char** argv) {
 const char kDepthUsage[] =
     "usage: ampi eval depth --images DIR --reference DIR [--model NAME | --weights FILE]\n"
     "                       [--reference-is-distance] [--working-size N] [--limit N] [--threads N]\n"
-    "       ampi eval depth --images DIR --ordinal FILE [--split val|test|train|all] [...]\n"
+    "       ampi eval depth --images DIR --ordinal FILE [--split val|test|holdout|train|all]\n"
+    "                       [...]\n"
     "\n"
     "The paper's depth metrics (delta < 1.25, 1.25^2, 1.25^3, RMSE, REL; Luvizon et al.,\n"
     "after Eigen et al. 2014) of the depth network on every photo under DIR (.jpg, .jpeg,\n"
@@ -187,7 +188,8 @@ const char kDepthUsage[] =
     "  --ordinal FILE            an ordinal set instead of reference maps (WHDR)\n"
     "  --split S                 the ordinal set's part scored: val (default), test (the\n"
     "                            validation photos' held-out pairs, never used to pick a\n"
-    "                            network), train or all\n"
+    "                            network), holdout (photos never trained or picked on,\n"
+    "                            scored only to judge a pick), train or all\n"
     "  --model M                 a bundled depth model by name: lite (default), heavy\n"
     "  --weights FILE            a depth weight file instead\n"
     "  --working-size N          the network's working size (default: the weight file's): the\n"
@@ -265,8 +267,8 @@ int eval_depth(int argc, char** argv) {
   p.flag("--reference-is-distance", &a.reference_is_distance);
   p.option("--ordinal", &a.ordinal);
   p.option("--split", [&](const std::string& v) {
-    if (v != "val" && v != "test" && v != "train" && v != "all")
-      throw std::runtime_error("--split: '" + v + "' is not val, test, train or all");
+    if (v != "val" && v != "test" && v != "holdout" && v != "train" && v != "all")
+      throw std::runtime_error("--split: '" + v + "' is not val, test, holdout, train or all");
     a.split = v;
   });
   p.option("--model", [&](const std::string& v) {

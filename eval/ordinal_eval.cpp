@@ -41,8 +41,8 @@ OrdinalPhoto read_photo_entry(const cv::FileNode& node, const std::string& path)
   photo.photo = read_string(node, "photo", path);
   const std::string where = path + ": " + photo.photo;
   photo.split = read_string(node, "split", where);
-  if (photo.split != "train" && photo.split != "val" && photo.split != "test")
-    fail(where, "split '" + photo.split + "' is not train, val or test");
+  if (photo.split != "train" && photo.split != "val" && photo.split != "test" && photo.split != "holdout")
+    fail(where, "split '" + photo.split + "' is not train, val, test or holdout");
   if (!node["width"].isInt() || !node["height"].isInt() || int(node["width"]) < 1 || int(node["height"]) < 1)
     fail(where, "width and height must be positive integers");
   photo.size = {int(node["width"]), int(node["height"])};

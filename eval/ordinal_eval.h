@@ -22,7 +22,8 @@ struct OrdinalPair {
 struct OrdinalPhoto {
   std::string photo;   // path relative to the photo folder, e.g. "sun80/x.jpg"
   cv::Size size;       // the photo's size when it was labelled
-  std::string split;   // "train", "val" or "test" (a validation photo's held-out pairs)
+  std::string split;   // "train", "val", "test" (a validation photo's held-out pairs) or
+                       // "holdout" (photos no network was trained or picked on)
   std::vector<OrdinalPair> pairs;
 };
 

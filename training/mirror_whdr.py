@@ -70,7 +70,7 @@ def whdr_both_ways(model, photos, long_side: int):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("weights", nargs="+", help="depth weight files (.ampw)")
-    ap.add_argument("--split", action="append", choices=("val", "test", "train"),
+    ap.add_argument("--split", action="append", choices=("val", "test", "holdout", "train"),
                     help="repeatable (default val and test)")
     ap.add_argument("--ordinal", default=str(ordinal_data.ORDINAL_FILE), help="the ordinal set (default the merged one)")
     ap.add_argument("--photos", default=str(photo_folder.photo_root()),

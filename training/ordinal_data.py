@@ -36,15 +36,15 @@ class OrdinalPhoto:
 
 
 def validation_photos(photo_root: Path, ordinal_file: Path = ORDINAL_FILE) -> set:
-    """Resolved paths of every photo of the validation split (its test part included),
-    labelled pairs or not: no other training data may show them (train_depth.py's
-    distilled source leaves them out)."""
+    """Resolved paths of every photo of the validation split (its test part included) and
+    of the holdout, labelled pairs or not: no other training data may show them
+    (train_depth.py's distilled source leaves them out)."""
     entries = json.loads(Path(ordinal_file).read_text())["photos"]
-    return {(Path(photo_root) / e["photo"]).resolve() for e in entries if e["split"] in ("val", "test")}
+    return {(Path(photo_root) / e["photo"]).resolve() for e in entries if e["split"] in ("val", "test", "holdout")}
 
 
 def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE, teacher_labels=None):
-    """The photos of one split ('train', 'val' or 'test') with their ordered pairs, and
+    """The photos of one split ('train', 'val', 'test' or 'holdout') with their ordered pairs, and
     with teacher_labels (an `ampi distill` label folder of photo_root) each photo's label."""
     entries = json.loads(Path(ordinal_file).read_text())["photos"]
     teacher = TeacherLabels(teacher_labels, photo_root) if teacher_labels else None
@@ -181,7 +181,7 @@ def main(argv=None):
     p = argparse.ArgumentParser(description="WHDR of an `ampi distill` label folder on the ordinal set: "
                                             "/usr/bin/python3 training/ordinal_data.py LABELS [--split test]")
     p.add_argument("labels", help="an ampi distill label folder of the photo folder")
-    p.add_argument("--split", default="val", choices=("train", "val", "test"))
+    p.add_argument("--split", default="val", choices=("train", "val", "test", "holdout"))
     p.add_argument("--ordinal", default=str(ORDINAL_FILE))
     args = p.parse_args(argv)
     whdr, pairs = labels_whdr(args.labels, args.split, photo_folder.photo_root(), args.ordinal)

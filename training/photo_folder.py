@@ -4,8 +4,9 @@ The photos (../shared/data/photos, or $AMPI_PHOTO_ROOT) are never copied into th
 repository. Splits go by a photo's place in its folder's sorted names, so that a copy of
 the folder with the same names (gpu_run.py's downscaled one) splits the same way: every
 tenth photo is validation (photo_split), every fifth is the real-photo ordinal validation
-(ordinal_split, a superset of the former). Scene seeds split too (is_validation_seed):
-validation scenes are textured only with validation photos.
+(ordinal_split, a superset of the former). Every second of the archive photos labelled
+last is the ordinal set's 'holdout' part (HOLDOUT_PREFIXES). Scene seeds split too
+(is_validation_seed): validation scenes are textured only with validation photos.
 """
 
 import functools
@@ -24,6 +25,13 @@ ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validati
 # the splits were fixed, so that validation and test stay the photos they were.
 ARCHIVE_FOLDER = 'archive'
 TRAINING_ONLY_FOLDERS = {ARCHIVE_FOLDER}
+# The archive photos labelled last (plasma-workspace-wallpapers', mate-backgrounds' and
+# gcompris-qt-data's), after every bundled network had been trained and picked: no pick has
+# seen them, unlike the val/test photos, picked on round after round. Every second of them
+# by sorted name is the 'holdout' part of the ordinal set: never trained on, never picked
+# on, scored only to judge a pick. The other half trains.
+HOLDOUT_PREFIXES = ('gcompris_', 'mate_', 'plasma_')
+HOLDOUT_PERIOD = 2
 
 
 def is_validation_seed(seed):
@@ -54,6 +62,18 @@ def _training_only(path):
     return Path(path).parent.name in TRAINING_ONLY_FOLDERS
 
 
+def _holdout(path):
+    """True for every HOLDOUT_PERIOD-th archive photo named with a HOLDOUT_PREFIXES prefix,
+    counted among those photos by sorted name."""
+    path = Path(path)
+    if not path.name.startswith(HOLDOUT_PREFIXES):
+        return False
+    names = [n for n in _photo_names(str(path.resolve().parent)) if n.startswith(HOLDOUT_PREFIXES)]
+    if path.name not in names:
+        raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
+    return names.index(path.name) % HOLDOUT_PERIOD == HOLDOUT_PERIOD - 1
+
+
 def photo_split(path):
     """'val' for every tenth photo of its folder by sorted name, else 'train'."""
     if _training_only(path):
@@ -64,9 +84,10 @@ def photo_split(path):
 def ordinal_split(path):
     """'val' for every fifth photo of its folder by sorted name (the synthetic validation
     photos and as many more), else 'train'. Ordinal validation photos are never trained on:
-    not ranked, and not textures of training scenes either."""
+    not ranked, and not textures of training scenes either. Archive photos are 'train'
+    but for the 'holdout' half of those labelled last, kept out of training the same way."""
     if _training_only(path):
-        return 'train'
+        return 'holdout' if _holdout(path) else 'train'
     return 'val' if _every_nth_of_folder(path, ORDINAL_VALIDATION_PERIOD) else 'train'
 
 

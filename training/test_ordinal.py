@@ -131,6 +131,16 @@ class Reading(unittest.TestCase):
             with self.assertRaisesRegex(RuntimeError, "archive/b.jpg is not under .*AMPI_PHOTO_ROOT"):
                 ordinal_data.load_split("val", root, root / "set.json")
 
+    def test_only_training_photos_are_left_to_training(self):
+        """validation_photos (kept out of every other training source) holds the val, test
+        and holdout photos, labelled or not."""
+        with tempfile.TemporaryDirectory() as folder:
+            root = Path(folder)
+            entries = [{"photo": f"{split}.png", "width": 4, "height": 4, "split": split, "pairs": []}
+                       for split in ("train", "val", "test", "holdout")]
+            (root / "set.json").write_text(json.dumps({"photos": entries}))
+            self.assertEqual(ordinal_data.validation_photos(root, root / "set.json"),
+                             {(root / f"{split}.png").resolve() for split in ("val", "test", "holdout")})
 
     def test_teacher_labels_are_read_at_the_photos_size(self):
         with tempfile.TemporaryDirectory() as folder:

@@ -272,6 +272,21 @@ class ValidationSplit(unittest.TestCase):
                 self.assertEqual([split(p) for p in linked], [split(shared / 'kodak24' / p.name) for p in linked])
                 self.assertEqual({split(p) for p in photos if p.parent.name == 'archive'}, {'train'})
 
+    def test_every_second_archive_photo_labelled_last_is_holdout(self):
+        """Counted among the HOLDOUT_PREFIXES photos alone, by sorted name; the other
+        archive photos train, and photo_split (the synthetic validation) is unchanged."""
+        with tempfile.TemporaryDirectory() as tmp:
+            archive = Path(tmp) / 'archive'
+            archive.mkdir()
+            names = ['a_photo.jpg', 'gcompris_x.jpg', 'lomiri_y.jpg', 'mate_z.jpg', 'plasma_1.jpg',
+                     'plasma_2.png', 'zz.jpg']
+            for name in names:
+                (archive / name).write_bytes(b'')
+            ordinal = {name: photo_folder.ordinal_split(archive / name) for name in names}
+            self.assertEqual(sorted(n for n, s in ordinal.items() if s == 'holdout'), ['mate_z.jpg', 'plasma_2.png'])
+            self.assertEqual(set(ordinal.values()), {'train', 'holdout'})
+            self.assertEqual({photo_folder.photo_split(archive / n) for n in names}, {'train'})
+
     def test_a_qt_resource_file_gives_back_its_files(self):
         """archive_photos.read_rcc on a version-3 resource file built here by the format: a
         folder holding a zlib-compressed file, a stored one and a zstd one (left out)."""

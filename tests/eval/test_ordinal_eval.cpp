@@ -18,7 +18,7 @@ const char kSet[] = R"({"seed": 1, "photos": [
   {"id": 1, "kind": "random", "a": [5.0, 25.0], "b": [30.5, 4], "label": "A"},
   {"id": 2, "kind": "random", "a": [10, 2.5], "b": [12, 28], "label": "B"},
   {"id": 3, "kind": "edge", "a": [20, 10], "b": [21, 11], "label": "="}]},
- {"photo": "b.png", "width": 8, "height": 8, "split": "train", "pairs": []}]})";
+ {"photo": "b.png", "width": 8, "height": 8, "split": "holdout", "pairs": []}]})";
 
 std::string error_of(const std::string& path) {
   try {
@@ -51,6 +51,7 @@ TEST_CASE("an ordinal set is read with its photos, points and labels", "[eval][o
   CHECK(set[0].pairs[0].a_nearer == 1);
   CHECK(set[0].pairs[1].a_nearer == -1);
   CHECK(set[0].pairs[2].a_nearer == 0);
+  CHECK(set[1].split == "holdout");
   CHECK(set[1].pairs.empty());
 }
 
@@ -90,7 +91,7 @@ TEST_CASE("a malformed ordinal set gets one error naming the file and the proble
   path = broken(R"("a": [5.0, 25.0])", R"("a": [5.0, 30.0])");
   CHECK(error_of(path) == path + ": sub/a.jpg: a point lies outside the photo");
   path = broken(R"("split": "val")", R"("split": "held-out")");
-  CHECK(error_of(path) == path + ": sub/a.jpg: split 'held-out' is not train, val or test");
+  CHECK(error_of(path) == path + ": sub/a.jpg: split 'held-out' is not train, val, test or holdout");
   path = broken(R"("width": 40)", R"("width": 0)");
   CHECK(error_of(path) == path + ": sub/a.jpg: width and height must be positive integers");
   path = dir.write("empty.json", R"({"photos": []})");

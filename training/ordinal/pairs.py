@@ -18,6 +18,8 @@ along the gradient), so the set also asks about object boundaries. Rounds were l
 one after another (round 1: pairs 1-7, round 2: 8-14, ..., round 7: 43-49); a new
 round adds pairs and leaves the earlier ones, and their labels, as they were. The
 validation photos' pairs of TEST_ROUNDS are merged as a part of their own, split 'test'.
+A photo's split is photo_folder.ordinal_split's: 'train', 'val', or 'holdout' (half of the
+archive photos labelled last).
 Nothing here looks at any network's output: the labels are what a person (or labelling
 agent) sees in the marked image (INSTRUCTIONS.md). Coordinates are pixels of the photo
 upright (turned by its EXIF orientation, as `ampi` reads it; x right, y down).
@@ -303,7 +305,7 @@ def cmd_merge(args):
     write_set(ORDINAL_FILE, {
         'seed': SEED, 'labels': 'A: a nearer, B: b nearer, =: too close to call',
         'votes': "every labeller's label; an order is kept only when all of them gave it"}, merged)
-    for split in ('train', 'val', 'test'):
+    for split in ('train', 'val', 'test', 'holdout'):
         chosen = [p for e in merged if e['split'] == split for p in e['pairs']]
         ordered = sum(p['label'] != '=' for p in chosen)
         n_photos = sum(e['split'] == split for e in merged)
