@@ -98,6 +98,7 @@ def depth_table(ampi, count, threads):
 
 
 ORDINAL_SET = REPO / 'training' / 'ordinal' / 'ordinal.json'
+ORDINAL_SPLITS = ('val', 'test', 'holdout', 'train')
 
 
 def ordinal_rows(out):
@@ -114,7 +115,7 @@ def ordinal_table(ampi, threads):
     import photo_folder
     root = photo_folder.photo_root()
     runs = []
-    for split in ('val', 'test', 'train'):
+    for split in ORDINAL_SPLITS:
         for model in ('lite', 'heavy'):
             command = [ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(ORDINAL_SET),
                        '--split', split, '--model', model, '--threads', str(threads)]
@@ -132,20 +133,24 @@ def ordinal_table(ampi, threads):
         '`vertical-gradient` (lower = nearer) and `constant` are the guesses a network must beat.',
         'The validation photos (every fifth of each folder) are never trained on: their pairs of',
         'rounds 1, 2, 4, 7 and 9 (`val`) pick the best of a training run, those of rounds 3, 5, 6',
-        "and 8 (`test`) never pick anything. The training photos' pairs are in the ranking loss",
-        '(those of the rounds each file trained on: `training/DEPTH.md`), so their row mostly',
-        'shows how well it is fitted.',
+        "and 8 (`test`) never pick anything; but the same photos picked round after round, so",
+        '`holdout` (every second archive photo of the last three packages labelled, added after',
+        'every bundled file was made) is the one part no choice has seen: never trained on, never',
+        "picked on, scored only to judge a pick. The training photos' pairs are in the ranking",
+        "loss (those of the rounds each file trained on: `training/DEPTH.md`), so their row",
+        'mostly shows how well it is fitted.',
         '',
         '| split | method | WHDR | pairs | photos |',
         '|---|---|---:|---:|---:|',
     ]
-    for split in ('val', 'test', 'train'):
+    for split in ORDINAL_SPLITS:
         split_runs = [r for r in runs if r[0] == split]
         rows = {m: ordinal_rows(out)[m] for _, m, _, out, _ in split_runs}
         guesses = ordinal_rows(split_runs[0][3])
         rows.update({g: guesses[g] for g in ('vertical-gradient', 'constant')})
         lines += [f'| {split} | {m} | {w:.4f} | {n} | {p} |' for m, (w, n, p) in rows.items()]
-    for split, what in (('val', 'validation pairs'), ('test', 'held-out test pairs')):
+    for split, what in (('val', 'validation pairs'), ('test', 'held-out test pairs'),
+                        ('holdout', 'holdout photos')):
         scored = {m: ordinal_rows(out) for s, m, _, out, _ in runs if s == split}
         gradient = scored['lite']['vertical-gradient'][0]
         for model in ('lite', 'heavy'):
