@@ -1,6 +1,6 @@
 """Exports a trained depth network to ampi's weight file (.ampw), ready for nets/depth_net.
 
-    /usr/bin/python3 training/export_depth.py training/runs/lite/checkpoint.pt weights/depth_lite.ampw
+    /usr/bin/python3 training/export_depth.py training/runs/lite/checkpoint.pt weights/depth_lite.ampw [--averaged]
 
 What the file holds (nets/ARCHITECTURE.md describes the graph these rebuild):
   - every convolution with its BatchNorm folded in (w' = w * g / sqrt(v + eps),
@@ -218,10 +218,15 @@ def unfold_batchnorm(model: depth_model.DepthNet, batches) -> depth_model.DepthN
     return model
 
 
-def load_checkpoint(path: str):
+def load_checkpoint(path: str, averaged: bool = False):
+    """The network of a train_depth.py checkpoint and the checkpoint; with averaged, the
+    weight average a checkpoint.pt of an --ema run keeps beside the raw weights (what its
+    validations measured), not the raw weights."""
     ckpt = torch.load(path, map_location="cpu", weights_only=False)
+    if averaged and "ema" not in ckpt:
+        raise SystemExit(f"{path}: no weight average (a checkpoint.pt of a run with --ema has one)")
     model = depth_model.build(ckpt["model_name"])
-    model.load_state_dict(ckpt["model"])
+    model.load_state_dict(ckpt["ema" if averaged else "model"])
     return model, ckpt
 
 
@@ -233,8 +238,10 @@ def main(argv=None):
     p.add_argument("--working-long-side", type=int, default=1024,
                    help="the long side inference should run at by default (a network trained on small "
                         "images generalises to a few times its training size, not to any)")
+    p.add_argument("--averaged", action="store_true",
+                   help="export a checkpoint.pt's weight average (--ema), not its raw weights")
     args = p.parse_args(argv)
-    model, ckpt = load_checkpoint(args.checkpoint)
+    model, ckpt = load_checkpoint(args.checkpoint, args.averaged)
     provenance = {"steps": int(ckpt["step"]), "data": args.data,
                   "best_val_loss": float(ckpt.get("best_val", ckpt.get("val_loss")))}
     if ckpt.get("ordinal_whdr") is not None:  # a best.pt kept by the ordinal validation

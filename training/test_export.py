@@ -72,6 +72,19 @@ class Export(unittest.TestCase):
         first = meta["depth.encoder.1"][:export_depth.FIELDS_PER_BLOCK]
         self.assertEqual(first, [0, 16, 0, 3, 0, 2])  # conv, 16 out, 3x3, hard-swish
 
+    def test_averaged_exports_the_weight_average_and_needs_one(self):
+        raw, average = (randomised(depth_model.build("lite"), seed) for seed in (SEED, SEED + 1))
+        with tempfile.TemporaryDirectory() as tmp:
+            path = Path(tmp) / "checkpoint.pt"
+            torch.save({"model_name": "lite", "model": raw.state_dict(), "ema": average.state_dict(), "step": 5}, path)
+            for averaged, expected in ((False, raw), (True, average)):
+                model, _ckpt = export_depth.load_checkpoint(str(path), averaged)
+                self.assertTrue(torch.equal(model.state_dict()["enc.0.0.bn.running_var"],
+                                            expected.state_dict()["enc.0.0.bn.running_var"]))
+            torch.save({"model_name": "lite", "model": raw.state_dict(), "step": 5}, path)
+            with self.assertRaisesRegex(SystemExit, "no weight average"):
+                export_depth.load_checkpoint(str(path), averaged=True)
+
     def test_sizes_match_the_paper(self):
         for name, paper_mb in (("lite", 10.6), ("heavy", 25.2)):
             mb = depth_model.folded_parameter_count(depth_model.build(name)) * 4 / 1e6
