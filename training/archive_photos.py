@@ -10,10 +10,11 @@ photographs listed below, taken from seven Debian packages (`apt-get download`, 
 no root needed; gcompris-qt-data's photos read out of its Qt resource files), long side
 brought to at most MAX_SIDE. Nothing goes into git.
 
-Every archive photo is a training photo (photo_folder.TRAINING_ONLY_FOLDERS): the
+No archive photo is a validation photo (photo_folder.NO_VALIDATION_FOLDERS): the
 validation and test photos stay those of ../shared, so every WHDR measured before
-still compares. Idempotent: photos already there are kept, packages already downloaded
-are not fetched again.
+still compares. They train, but for half of the last three packages' photos, the ordinal
+set's holdout (photo_folder.HOLDOUT_PREFIXES). Idempotent: photos already there are kept,
+packages already downloaded are not fetched again.
 
 Which images: every photograph of a three-dimensional scene in these packages, chosen
 by looking at them before any network saw them. Left out: patterns, illustrations and

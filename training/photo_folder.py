@@ -21,10 +21,11 @@ DEFAULT_PHOTO_ROOT = Path(__file__).resolve().parents[2] / 'shared' / 'data' / '
 VALIDATION_SEED_START = 10 ** 9
 VALIDATION_PHOTO_PERIOD = 10      # every tenth photo of a folder (by sorted name) is validation
 ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validation (training/ordinal)
-# Folders whose photos are all training photos: training/archive_photos.py's, added after
-# the splits were fixed, so that validation and test stay the photos they were.
+# Folders with no validation photos: training/archive_photos.py's, added after the splits
+# were fixed, so that validation and test stay the photos they were. Their photos train,
+# but for the holdout below.
 ARCHIVE_FOLDER = 'archive'
-TRAINING_ONLY_FOLDERS = {ARCHIVE_FOLDER}
+NO_VALIDATION_FOLDERS = {ARCHIVE_FOLDER}
 # The archive photos labelled last (plasma-workspace-wallpapers', mate-backgrounds' and
 # gcompris-qt-data's), after every bundled network had been trained and picked: no pick has
 # seen them, unlike the val/test photos, picked on round after round. Every second of them
@@ -58,8 +59,8 @@ def _every_nth_of_folder(path, period):
     return names.index(path.name) % period == period - 1
 
 
-def _training_only(path):
-    return Path(path).parent.name in TRAINING_ONLY_FOLDERS
+def _without_validation(path):
+    return Path(path).parent.name in NO_VALIDATION_FOLDERS
 
 
 def _holdout(path):
@@ -76,7 +77,7 @@ def _holdout(path):
 
 def photo_split(path):
     """'val' for every tenth photo of its folder by sorted name, else 'train'."""
-    if _training_only(path):
+    if _without_validation(path):
         return 'train'
     return 'val' if _every_nth_of_folder(path, VALIDATION_PHOTO_PERIOD) else 'train'
 
@@ -86,7 +87,7 @@ def ordinal_split(path):
     photos and as many more), else 'train'. Ordinal validation photos are never trained on:
     not ranked, and not textures of training scenes either. Archive photos are 'train'
     but for the 'holdout' half of those labelled last, kept out of training the same way."""
-    if _training_only(path):
+    if _without_validation(path):
         return 'holdout' if _holdout(path) else 'train'
     return 'val' if _every_nth_of_folder(path, ORDINAL_VALIDATION_PERIOD) else 'train'
 
@@ -99,7 +100,7 @@ def missing_photo(source, photo, root):
     """The one-line error for a photo that source names and root lacks: for an archive
     photo, how to make the root that holds it."""
     hint = ''
-    if Path(photo).parent.name in TRAINING_ONLY_FOLDERS:
+    if Path(photo).parent.name in NO_VALIDATION_FOLDERS:
         hint = (' (the archive photos: run training/archive_photos.py and set '
                 'AMPI_PHOTO_ROOT=training/data_cache/photos)')
     return f'{source}: {photo} is not under {root}{hint}'
