@@ -23,7 +23,7 @@ struct OrdinalPhoto {
   std::string photo;   // path relative to the photo folder, e.g. "sun80/x.jpg"
   cv::Size size;       // the photo's size when it was labelled
   std::string split;   // "train", "val", "test" (a validation photo's held-out pairs) or
-                       // "holdout" (photos no network was trained or picked on)
+                       // "holdout" (photos kept from training and from picking)
   std::vector<OrdinalPair> pairs;
 };
 
