@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 import torch
-import torch.nn.functional as F
 from PIL import Image
 
 HERE = Path(__file__).resolve().parent
@@ -33,7 +32,9 @@ from ampw import read_ampw  # noqa: E402
 
 def engine_input(photo, long_side: int):
     """(image [3, h, w] in [0, 1], points in its pixels): the full photo's long side
-    brought to long_side, aspect kept, never enlarged (nets/depth_model.cpp)."""
+    brought to long_side, aspect kept, never enlarged (nets/depth_model.cpp). Unlike
+    ordinal_data.validation_sample, whose resize takes PIL's reducing_gap shortcut, this is
+    the exact tent filter the engine shrinks with (pipeline/tent_resize.h)."""
     height, width = photo.rgb.shape[:2]
     scale = min(1.0, long_side / max(height, width))
     size = (max(1, round(width * scale)), max(1, round(height * scale)))
@@ -44,12 +45,8 @@ def engine_input(photo, long_side: int):
 
 def disparity_of(model, image: torch.Tensor, mirrored: bool) -> torch.Tensor:
     """The network's disparity [1, h, w] of image, mirrored in and back out when asked."""
-    height, width = image.shape[-2:]
-    if mirrored:
-        image = image.flip(-1)
-    padded = F.pad(image[None], (0, (-width) % model.multiple, 0, (-height) % model.multiple), mode="replicate")
     with torch.no_grad():
-        disparity = model(padded.contiguous(memory_format=torch.channels_last))[-1][0, :, :height, :width]
+        disparity = ordinal_data.engine_disparity(model, image.flip(-1) if mirrored else image)
     return disparity.flip(-1) if mirrored else disparity
 
 
@@ -70,7 +67,7 @@ def whdr_both_ways(model, photos, long_side: int):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("weights", nargs="+", help="depth weight files (.ampw)")
-    ap.add_argument("--split", action="append", choices=("val", "test", "holdout", "train"),
+    ap.add_argument("--split", action="append", choices=ordinal_data.SPLITS,
                     help="repeatable (default val and test)")
     ap.add_argument("--ordinal", default=str(ordinal_data.ORDINAL_FILE), help="the ordinal set (default the merged one)")
     ap.add_argument("--photos", default=str(photo_folder.photo_root()),

@@ -22,6 +22,7 @@ import distill
 import photo_folder
 
 ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json"
+SPLITS = ("train", "val", "test", "holdout")  # an ordinal.json photo entry's parts (training/ordinal/README.md)
 PHOTO_MAX_SIDE = 640      # photos are kept decoded at this size (training crops are smaller)
 CROP_SHARE = (0.7, 1.0)   # a training crop keeps this share of each side
 WIDE_CROP_SHARE = (0.5, 1.0)  # train_depth.py --photo-augment: more zoom, more views of few photos
@@ -138,6 +139,14 @@ def validation_sample(photo: OrdinalPhoto, long_side: int):
     return image, torch.from_numpy(points), torch.from_numpy(photo.signs)
 
 
+def engine_disparity(model, image: torch.Tensor, device="cpu") -> torch.Tensor:
+    """The network's disparity [1, h, w] of image [3, h, w], run as the engine runs it:
+    edge-replicated to the network's multiple, the output cropped back (nets/depth_net.cpp)."""
+    height, width = image.shape[-2:]
+    padded = F.pad(image[None], (0, (-width) % model.multiple, 0, (-height) % model.multiple), mode="replicate")
+    return model(padded.to(device).contiguous(memory_format=torch.channels_last))[-1][0, :, :height, :width]
+
+
 def read_at(disparity: torch.Tensor, points: torch.Tensor) -> torch.Tensor:
     """disparity [1, H, W] read bilinearly at points [P, 2, 2] (pixel x, y): [P, 2]."""
     h, w = disparity.shape[-2:]
@@ -181,7 +190,7 @@ def main(argv=None):
     p = argparse.ArgumentParser(description="WHDR of an `ampi distill` label folder on the ordinal set: "
                                             "/usr/bin/python3 training/ordinal_data.py LABELS [--split test]")
     p.add_argument("labels", help="an ampi distill label folder of the photo folder")
-    p.add_argument("--split", default="val", choices=("train", "val", "test", "holdout"))
+    p.add_argument("--split", default="val", choices=SPLITS)
     p.add_argument("--ordinal", default=str(ORDINAL_FILE))
     args = p.parse_args(argv)
     whdr, pairs = labels_whdr(args.labels, args.split, photo_folder.photo_root(), args.ordinal)

@@ -49,11 +49,11 @@ def _photo_names(folder):
     return tuple(sorted(p.name for p in entries if p.suffix.lower() in PHOTO_SUFFIXES))
 
 
-def _every_nth_of_folder(path, period):
+def _every_nth_of_folder(path, period, prefixes=('',)):
     """True for every period-th photo of its folder by sorted name (indices period - 1,
-    2 period - 1, ...)."""
+    2 period - 1, ...), counted among the photos whose names start with one of prefixes."""
     path = Path(path)
-    names = _photo_names(str(path.resolve().parent))
+    names = [n for n in _photo_names(str(path.resolve().parent)) if n.startswith(prefixes)]
     if path.name not in names:
         raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
     return names.index(path.name) % period == period - 1
@@ -66,13 +66,8 @@ def _without_validation(path):
 def _holdout(path):
     """True for every HOLDOUT_PERIOD-th archive photo named with a HOLDOUT_PREFIXES prefix,
     counted among those photos by sorted name."""
-    path = Path(path)
-    if not path.name.startswith(HOLDOUT_PREFIXES):
-        return False
-    names = [n for n in _photo_names(str(path.resolve().parent)) if n.startswith(HOLDOUT_PREFIXES)]
-    if path.name not in names:
-        raise ValueError(f'{path}: not a photo (.jpg, .jpeg, .png) in its folder')
-    return names.index(path.name) % HOLDOUT_PERIOD == HOLDOUT_PERIOD - 1
+    return (Path(path).name.startswith(HOLDOUT_PREFIXES)
+            and _every_nth_of_folder(path, HOLDOUT_PERIOD, HOLDOUT_PREFIXES))
 
 
 def photo_split(path):

@@ -309,15 +309,12 @@ def validate(model, batches, device="cpu", invariant=False):
 @torch.no_grad()
 def validate_ordinal(model, photos, long_side: int, device="cpu"):
     """WHDR of the network on the ordinal validation photos, each run as the engine runs
-    it: long side long_side, aspect kept, edge-replicated to the network's multiple and
-    the output cropped back (nets/depth_net.cpp)."""
+    it: long side long_side, aspect kept (ordinal_data.validation_sample, engine_disparity)."""
     model.eval()
     wrong, pairs = 0.0, 0
     for photo in photos:
         rgb, points, signs = ordinal_data.validation_sample(photo, long_side)
-        height, width = rgb.shape[-2:]
-        padded = F.pad(rgb[None], (0, (-width) % model.multiple, 0, (-height) % model.multiple), mode="replicate")
-        disparity = model(padded.to(device).contiguous(memory_format=torch.channels_last))[-1][0, :, :height, :width]
+        disparity = ordinal_data.engine_disparity(model, rgb, device)
         photo_wrong, photo_pairs = ordinal_data.whdr_counts(disparity.cpu(), points, signs)
         wrong, pairs = wrong + photo_wrong, pairs + photo_pairs
     model.train()
