@@ -179,8 +179,10 @@ const char kDepthUsage[] =
     "With --ordinal, real photos are judged by point pairs labelled by eye instead\n"
     "(training/ordinal/ordinal.json; DIR is the folder its photo names are relative to):\n"
     "WHDR, the share of pairs labelled A or B nearer whose order the network's disparity\n"
-    "(bilinear at the two points) gets wrong; a tie counts half. Beside it the vertical\n"
-    "gradient (lower = nearer) and a constant map (0.5, every pair a tie).\n"
+    "(bilinear at the two points) gets wrong; a tie counts half. NAME-snapped scores the\n"
+    "map `ampi run` slices: the disparity with its depth edges snapped to the photo\n"
+    "(unless ampi run --no-edge-snap). Beside them the vertical gradient (lower = nearer) and\n"
+    "a constant map (0.5, every pair a tie).\n"
     "\n"
     "  --images DIR              photos\n"
     "  --reference DIR           reference depth maps, same relative paths and names\n"
@@ -233,7 +235,7 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
   const std::unique_ptr<DepthModel> net = load_depth_net(a);
   if (a.working_size) set_working_size_option(*net, a.working_size);
   const int side = 0;  // the network's working size, set above
-  OrdinalScore network, gradient, constant;
+  OrdinalScore network, snapped, gradient, constant;
   for (const OrdinalPhoto& e : set) {
     const std::string path = (fs::path(a.images) / e.photo).string();
     const cv::Mat bgr = read_photo(path);
@@ -241,8 +243,10 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
       throw std::runtime_error(path + ": is " + std::to_string(bgr.cols) + "x" + std::to_string(bgr.rows) +
                                " but was labelled at " + std::to_string(e.size.width) + "x" +
                                std::to_string(e.size.height));
-    const OrdinalScore s = score_ordinal(estimate_disparity(*net, bgr, side), e);
+    const cv::Mat disparity = estimate_disparity(*net, bgr, side);
+    const OrdinalScore s = score_ordinal(disparity, e);
     network.add(s);
+    snapped.add(score_ordinal(snap_depth_edges(bgr, disparity).disparity, e));
     gradient.add(score_ordinal(vertical_gradient_disparity(e.size), e));
     constant.add(score_ordinal(cv::Mat(e.size, CV_32FC1, cv::Scalar(1)), e));
     std::fprintf(stderr, "%s: %d pairs, WHDR %.4f\n", e.photo.c_str(), s.pairs, s.whdr());
@@ -251,7 +255,9 @@ int eval_depth_ordinal(const DepthEvalArgs& a) {
   std::set<std::string> names;  // a validation photo has a val and a test entry
   for (const OrdinalPhoto& e : set) names.insert(e.photo);
   const int photos = int(names.size());
-  print_ordinal_row(a.weights.empty() ? a.model : fs::path(a.weights).filename().string(), network, photos);
+  const std::string name = a.weights.empty() ? a.model : fs::path(a.weights).filename().string();
+  print_ordinal_row(name, network, photos);
+  print_ordinal_row(name + "-snapped", snapped, photos);
   print_ordinal_row("vertical-gradient", gradient, photos);
   print_ordinal_row("constant", constant, photos);
   std::printf("(WHDR: share of labelled pairs ordered wrongly, lower is better; split %s; see --help)\n",

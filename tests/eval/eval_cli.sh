@@ -93,6 +93,8 @@ if "$ampi" eval depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --thr
     fail "ordinal: the gradient should order both pairs: $(cat "$tmp/out")"
   row "$tmp/out" constant | awk '{ exit !($2 == 0.5) }' || fail "ordinal: constant should score 0.5: $(cat "$tmp/out")"
   row "$tmp/out" lite | awk '{ exit !($2 >= 0 && $2 <= 1 && $3 == 2) }' || fail "ordinal: no lite row: $(cat "$tmp/out")"
+  row "$tmp/out" lite-snapped | awk '{ exit !($2 >= 0 && $2 <= 1 && $3 == 2) }' ||
+    fail "ordinal: no row for the snapped map: $(cat "$tmp/out")"
   [ "$failures" -ne "$before" ] || echo "ok: eval depth --ordinal -> $(tr '\n' ' ' <"$tmp/out")"
 else
   fail "eval depth --ordinal: exit status $?: $(cat "$tmp/err")"
