@@ -205,13 +205,17 @@ class Labelling(unittest.TestCase):
             self.assertEqual(first.read_bytes(), second.read_bytes())
 
     def test_a_subset_keeps_the_named_photos_and_rounds(self):
-        def entry(name, ids):
-            return {"photo": name, "pairs": [{"id": i, "label": "A"} for i in ids]}
+        def entry(name, ids):  # pairs 6 and 7 of a round are its edge pairs
+            return {"photo": name, "pairs": [{"id": i, "label": "A", "kind": "edge" if (i - 1) % 7 >= 5 else "random"}
+                                             for i in ids]}
         photos = [entry("archive/mate_a.jpg", [1, 8, 15]), entry("archive/opencv_b.jpg", [2]),
-                  entry("kodak24/c.png", [3, 9]), entry("archive/plasma_d.jpg", [16])]
+                  entry("kodak24/c.png", [3, 9, 13]), entry("archive/plasma_d.jpg", [16])]
         self.assertEqual(pairs.subset(photos, ["archive/mate_", "archive/plasma_"], (1, 2)),
                          [entry("archive/mate_a.jpg", [1, 8])])
-        self.assertEqual(pairs.subset(photos, [], (2, 2)), [entry("archive/mate_a.jpg", [8]), entry("kodak24/c.png", [9])])
+        self.assertEqual(pairs.subset(photos, [], (2, 2)),
+                         [entry("archive/mate_a.jpg", [8]), entry("kodak24/c.png", [9, 13])])
+        self.assertEqual(pairs.subset(photos, [], (1, 3), "edge"), [entry("kodak24/c.png", [13])])
+        self.assertEqual(pairs.subset(photos, ["kodak24/"], (1, 3), "random"), [entry("kodak24/c.png", [3, 9])])
 
     def test_an_order_is_kept_only_when_every_labeller_gave_it(self):
         self.assertEqual(pairs.consensus(["A"]), "A")

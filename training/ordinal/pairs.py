@@ -6,7 +6,7 @@ them by eye, and the merged label file.
     /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json.gz
     /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--round N] [--only REL...]
     /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
-    /usr/bin/python3 training/ordinal/pairs.py subset OUT [--prefix archive/...] [--rounds 1-2]
+    /usr/bin/python3 training/ordinal/pairs.py subset OUT [--prefix archive/...] [--rounds 1-2] [--kind edge]
 
 (training/archive_photos.py makes that root; `sample` from ../shared alone would leave the
 archive photos out.)
@@ -318,11 +318,13 @@ def cmd_merge(args):
 # ----------------------------------------------------------------------------------
 # A part of the merged set, for a WHDR of its own
 
-def subset(photos: list, prefixes, rounds) -> list:
+def subset(photos: list, prefixes, rounds, kind=None) -> list:
     """The entries of photos whose name starts with one of prefixes (all when none), each
-    keeping only its pairs of rounds (first, last); entries left empty are dropped."""
+    keeping only its pairs of rounds (first, last) and, when given, of one kind ('random' or
+    'edge'); entries left empty are dropped."""
     first, last = rounds
-    kept = [dict(e, pairs=[p for p in e['pairs'] if first <= round_of(p['id']) <= last])
+    kept = [dict(e, pairs=[p for p in e['pairs'] if first <= round_of(p['id']) <= last
+                           and kind in (None, p['kind'])])
             for e in photos if not prefixes or e['photo'].startswith(tuple(prefixes))]
     return [e for e in kept if e['pairs']]
 
@@ -330,7 +332,7 @@ def subset(photos: list, prefixes, rounds) -> list:
 def cmd_subset(args):
     whole = json.loads(ORDINAL_FILE.read_text())
     first, _, last = args.rounds.partition('-')
-    photos = subset(whole['photos'], args.prefix, (int(first), int(last or first)))
+    photos = subset(whole['photos'], args.prefix, (int(first), int(last or first)), args.kind)
     write_set(Path(args.out), {k: v for k, v in whole.items() if k != 'photos'}, photos)
     ordered = sum(p['label'] != '=' for e in photos for p in e['pairs'])
     print(f'{args.out}: {len(photos)} photos, {ordered} ordered pairs')
@@ -351,6 +353,8 @@ def main():
     s.add_argument('--prefix', action='append', default=[],
                    help='keep the photos whose name starts with this (repeatable; default all)')
     s.add_argument('--rounds', default=f'1-{ROUNDS}', help='keep these rounds: N or FIRST-LAST')
+    s.add_argument('--kind', choices=('random', 'edge'),
+                   help='keep only the uniform pairs or only those across image edges (default both)')
     args = ap.parse_args()
     {'sample': cmd_sample, 'draw': cmd_draw, 'merge': cmd_merge, 'subset': cmd_subset}[args.command](args)
 
