@@ -13,7 +13,9 @@ of ../shared/data/photos, training/photo_folder.py photo_split), `ampi eval slic
 default (optimal) slicer, with the paper's rule exactly and with its former plane guard;
 the tear penalty's tuning runs on training photos; the default on 50 synthetic scenes
 with their exact depth. ordinal: WHDR of the lite and heavy networks on the real-photo
-ordinal set (training/ordinal/), its validation photos and, for reference, its training ones.
+ordinal set (training/ordinal/), its validation photos and, for reference, its training ones,
+as they are and as `ampi run` slices them (edges snapped); on val and test also the uniform
+pairs and those across image edges apart, and other working sizes.
 edges: `ampi eval edges` on its scene set with the built-in textures and with textures cut
 from three validation photos.
 The tables quote ampi's output verbatim, with the command that made it.
@@ -99,6 +101,7 @@ def depth_table(ampi, count, threads):
 
 ORDINAL_SET = REPO / 'training' / 'ordinal' / 'ordinal.json'
 ORDINAL_SPLITS = ('val', 'test', 'holdout', 'train')
+SECTION_SPLITS = ('val', 'test')  # the sections' splits; holdout is kept for judging picks
 
 
 def ordinal_rows(out):
@@ -138,14 +141,16 @@ def ordinal_table(ampi, threads):
         'every bundled file was made) is the one part no choice has seen: never trained on, never',
         "picked on, scored only to judge a pick. The training photos' pairs are in the ranking",
         "loss (those of the rounds each file trained on: `training/DEPTH.md`), so their row",
-        'mostly shows how well it is fitted.',
+        'mostly shows how well it is fitted. `-snapped` scores the map `ampi run` slices, the',
+        "network's disparity with its depth edges snapped to the photo (`slicing/depth_edges.h`).",
         '',
         '| split | method | WHDR | pairs | photos |',
         '|---|---|---:|---:|---:|',
     ]
     for split in ORDINAL_SPLITS:
         split_runs = [r for r in runs if r[0] == split]
-        rows = {m: ordinal_rows(out)[m] for _, m, _, out, _ in split_runs}
+        rows = {name: row for _, m, _, out, _ in split_runs for name, row in ordinal_rows(out).items()
+                if name in (m, f'{m}-snapped')}
         guesses = ordinal_rows(split_runs[0][3])
         rows.update({g: guesses[g] for g in ('vertical-gradient', 'constant')})
         lines += [f'| {split} | {m} | {w:.4f} | {n} | {p} |' for m, (w, n, p) in rows.items()]
@@ -159,10 +164,74 @@ def ordinal_table(ampi, threads):
             side = 'below (better than)' if gain > 0 else 'above (worse than)'
             lines.append(f'\n{model} on the {what}: WHDR {whdr:.4f}, {abs(gain):.1f} points {side} the '
                          f'vertical gradient\'s {gradient:.4f} (the target for lite: at least 10 below).')
+    lines += ['', *pair_kind_section(ampi, threads, root)]
+    lines += ['', *working_size_section(ampi, threads, root)]
     lines += ['', 'The outputs these rows are copied from:', '']
     for split, model, command, out, seconds in runs:
         lines += [f'## {model}, {split}', '', f'`{command}` ({seconds:.0f} s)', '', '```', out.rstrip(), '```', '']
     return '\n'.join(lines)
+
+
+def pair_kind_section(ampi, threads, root):
+    """WHDR of each bundled network, its map as `ampi run` slices it and the gradient on
+    the uniform pairs and on the pairs across image edges, apart, on val and test."""
+    whdr = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        for kind in ('random', 'edge'):
+            part = Path(tmp) / f'{kind}.json'
+            subprocess.run([sys.executable, str(REPO / 'training' / 'ordinal' / 'pairs.py'), 'subset', str(part),
+                            '--kind', kind], check=True, capture_output=True)
+            for model in ('lite', 'heavy'):
+                for split in SECTION_SPLITS:
+                    out, _ = run([ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(part),
+                                  '--split', split, '--model', model, '--threads', str(threads)])
+                    whdr.update({(kind, split, name): row for name, row in ordinal_rows(out).items()})
+    methods = ('lite', 'lite-snapped', 'heavy', 'heavy-snapped', 'vertical-gradient')
+    return [
+        '## Uniform pairs and pairs across edges',
+        '',
+        'Each round of a photo has five pairs drawn uniformly and two straddling a strong image',
+        'edge (`training/ordinal/README.md`). Each part alone: `training/ordinal/pairs.py subset',
+        'PART.json --kind random|edge`, then `ampi eval depth --ordinal PART.json` as above.',
+        '',
+        '| pairs | split | pairs scored | ' + ' | '.join(methods) + ' |',
+        '|---|---|---:|' + '---:|' * len(methods),
+        *[f'| {kind} | {split} | {whdr[kind, split, "lite"][1]} | '
+          + ' | '.join(f'{whdr[kind, split, m][0]:.4f}' for m in methods) + ' |'
+          for kind in ('random', 'edge') for split in SECTION_SPLITS],
+    ]
+
+
+WORKING_SIZES = (192, 256, 320, 384, 512)
+
+
+def working_size_section(ampi, threads, root):
+    """WHDR of each bundled network at long sides other than the 256 it was trained and
+    picked at (`--working-size`), on val and test."""
+    whdr = {}
+    for model in ('lite', 'heavy'):
+        for size in WORKING_SIZES:
+            for split in SECTION_SPLITS:
+                out, _ = run([ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(ORDINAL_SET),
+                              '--split', split, '--model', model, '--threads', str(threads),
+                              '--working-size', str(size)])
+                whdr[model, size, split] = ordinal_rows(out)[model][0]
+    columns = [(m, s) for m in ('lite', 'heavy') for s in SECTION_SPLITS]
+    return [
+        '## Working size',
+        '',
+        'Both networks were trained on 256x192 crops and are run with the long side at 256',
+        '(their files\' `depth.working_long_side`). `--working-size N` runs them at another',
+        'long side; each cell is the WHDR row of `ampi eval depth --images PHOTOS --ordinal',
+        'training/ordinal/ordinal.json --split SPLIT --model MODEL --working-size N`.',
+        'A larger working size does not order depth better: each network orders best at the',
+        'frame size it was trained at.',
+        '',
+        '| long side | ' + ' | '.join(f'{m} {s}' for m, s in columns) + ' |',
+        '|---:|' + '---:|' * len(columns),
+        *[f'| {size} | ' + ' | '.join(f'{whdr[m, size, s]:.4f}' for m, s in columns) + ' |'
+          for size in WORKING_SIZES],
+    ]
 
 
 def link_photos(folder, photos, root):
