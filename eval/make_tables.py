@@ -206,8 +206,8 @@ WORKING_SIZES = (192, 256, 320, 384, 512)
 
 
 def working_size_section(ampi, threads, root):
-    """WHDR of each bundled network at long sides other than the 256 it was trained and
-    picked at (`--working-size`), on val and test."""
+    """WHDR of each bundled network at several long sides (`--working-size`), 256, the one
+    it was trained and picked at, among them; on val and test."""
     whdr = {}
     for model in ('lite', 'heavy'):
         for size in WORKING_SIZES:
