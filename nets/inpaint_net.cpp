@@ -35,6 +35,11 @@ ActivationSpec activation_from_name(const WeightFile& f, const std::string& key)
   }
 }
 
+// Far above any real layer's channels, kernel or dilation, and small enough that the int
+// arithmetic on them (padding = dilation * (kernel - 1) / 2, summed and gated channel
+// counts) cannot overflow whatever a damaged file holds.
+constexpr int64_t kMaxGraphValue = 1 << 14;
+
 // The graph as written by training/export_inpaint.py: one entry per layer in each array.
 std::vector<InpaintLayer> read_graph(const WeightFile& f) {
   static const char* const kArrays[] = {"source", "upsample", "skip", "in_channels", "out_channels",
@@ -47,6 +52,11 @@ std::vector<InpaintLayer> read_graph(const WeightFile& f) {
     if (cols[a].size() != n)
       fail(f, std::string("inpaint.") + kArrays[a] + " has " + std::to_string(cols[a].size()) +
                   " entries for " + std::to_string(n) + " layers");
+  for (size_t a = 0; a < cols.size(); ++a)
+    for (int64_t v : cols[a])
+      if (v < InpaintLayer::kNoSkip || v > kMaxGraphValue)
+        fail(f, std::string("inpaint.") + kArrays[a] + " holds " + std::to_string(v) + ", outside " +
+                    std::to_string(InpaintLayer::kNoSkip) + ".." + std::to_string(kMaxGraphValue));
   std::vector<InpaintLayer> layers(n);
   for (size_t i = 0; i < n; ++i) {
     InpaintLayer& l = layers[i];

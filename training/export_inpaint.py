@@ -174,6 +174,9 @@ def write_bad_fixtures():
     write_ampw(os.path.join(FIXTURES, "bad_channels.ampw"), {}, bad_channels)
     bad_source = dict(meta, **{"inpaint.source": [-1, 3] + meta["inpaint.source"][2:]})
     write_ampw(os.path.join(FIXTURES, "bad_source.ampw"), {}, bad_source)
+    huge = 1 << 30  # padding dilation * (kernel - 1) / 2 would overflow an int
+    bad_dilation = dict(meta, **{"inpaint.dilation": [huge] + meta["inpaint.dilation"][1:]})
+    write_ampw(os.path.join(FIXTURES, "bad_dilation.ampw"), {}, bad_dilation)
     bad_prefill = dict(meta, **{"inpaint.prefill": "telea"})
     write_ampw(os.path.join(FIXTURES, "bad_prefill.ampw"), {}, bad_prefill)
     write_ampw(os.path.join(FIXTURES, "no_tensors.ampw"), {}, meta)

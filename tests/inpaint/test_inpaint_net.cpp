@@ -164,6 +164,8 @@ TEST_CASE("inpaint net: bad inputs and bad files are one-line errors", "[inpaint
   CHECK(channels.rfind(kFixtures + "bad_channels.ampw: layer enc2: in_channels", 0) == 0);
   const std::string forward = expect_load_error("bad_source.ampw");
   CHECK(forward.rfind(kFixtures + "bad_source.ampw: layer enc2: source is not an earlier layer", 0) == 0);
+  const std::string dilation = expect_load_error("bad_dilation.ampw");  // found by fuzz_networks
+  CHECK(dilation == kFixtures + "bad_dilation.ampw: inpaint.dilation holds 1073741824, outside -2..16384");
   const std::string missing = expect_load_error("no_tensors.ampw");
   CHECK(missing.rfind(kFixtures + "no_tensors.ampw: ", 0) == 0);
   CHECK(missing.find("enc1.weight") != std::string::npos);
