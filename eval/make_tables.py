@@ -114,14 +114,19 @@ def ordinal_rows(out):
     return rows
 
 
+def ordinal_command(ampi, root, ordinal_set, split, model, threads, *extra):
+    """The `ampi eval depth --ordinal` command line that every row of the tables runs."""
+    return [ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(ordinal_set),
+            '--split', split, '--model', model, '--threads', str(threads), *extra]
+
+
 def ordinal_table(ampi, threads):
     import photo_folder
     root = photo_folder.photo_root()
     runs = []
     for split in ORDINAL_SPLITS:
         for model in ('lite', 'heavy'):
-            command = [ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(ORDINAL_SET),
-                       '--split', split, '--model', model, '--threads', str(threads)]
+            command = ordinal_command(ampi, root, ORDINAL_SET, split, model, threads)
             out, seconds = run(command)
             runs.append((split, model, shown(command).replace(str(root), 'PHOTOS'), out, seconds))
     lines = [
@@ -183,8 +188,7 @@ def pair_kind_section(ampi, threads, root):
                             '--kind', kind], check=True, capture_output=True)
             for model in ('lite', 'heavy'):
                 for split in SECTION_SPLITS:
-                    out, _ = run([ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(part),
-                                  '--split', split, '--model', model, '--threads', str(threads)])
+                    out, _ = run(ordinal_command(ampi, root, part, split, model, threads))
                     whdr.update({(kind, split, name): row for name, row in ordinal_rows(out).items()})
     methods = ('lite', 'lite-snapped', 'heavy', 'heavy-snapped', 'vertical-gradient')
     return [
@@ -212,9 +216,8 @@ def working_size_section(ampi, threads, root):
     for model in ('lite', 'heavy'):
         for size in WORKING_SIZES:
             for split in SECTION_SPLITS:
-                out, _ = run([ampi, 'eval', 'depth', '--images', str(root), '--ordinal', str(ORDINAL_SET),
-                              '--split', split, '--model', model, '--threads', str(threads),
-                              '--working-size', str(size)])
+                out, _ = run(ordinal_command(ampi, root, ORDINAL_SET, split, model, threads,
+                                             '--working-size', str(size)))
                 whdr[model, size, split] = ordinal_rows(out)[model][0]
     columns = [(m, s) for m in ('lite', 'heavy') for s in SECTION_SPLITS]
     return [
