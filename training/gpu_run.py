@@ -12,8 +12,9 @@ train_inpaint.py).
 
 The GPU machine gets only the working tree and the carried folder (64 MiB in all), not
 ../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the
-same folder and file names, so the train/validation splits are the same there, and the
-ordinal set with its points scaled to those sizes. The inpainting run trains on the same
+same folder and file names, so the train/validation splits are the same there; train.sh
+first scales the ordinal set's points to those sizes there (`gpu_run.py ordinal`), from
+the set that travels with the working tree, so that only one copy of it takes room. The inpainting run trains on the same
 photos, so at most 384 px there against inpaint_data.MAX_SIDE = 768 here: a photo of 768
 px or more is seen at half the scale. For each photo with a cached disparity map
 (--disparity-dir) it gets the plane map its slicing would make of that map at the carried
@@ -133,7 +134,7 @@ def half_if_exact_enough(tensor):
 
 def pack_photos(out: Path):
     """Every photo at most PHOTO_LONG_SIDE, as JPEG under its own relative name; returns
-    {relative name: (scale x, scale y, new width, new height)}."""
+    {relative name: (width, height) there}."""
     root = photo_folder.photo_root()
     sizes = {}
     for path in photo_folder.list_photos():
@@ -145,20 +146,23 @@ def pack_photos(out: Path):
         target = out / rel
         target.parent.mkdir(parents=True, exist_ok=True)
         small.save(target, format="JPEG", quality=PHOTO_QUALITY)  # keeps the name, and so the split
-        sizes[rel] = (small.width / image.width, small.height / image.height, small.width, small.height)
+        sizes[rel] = small.size
     return sizes
 
 
-def scaled_ordinal_set(ordinal: Path, sizes) -> dict:
-    """The ordinal set for the carried photos: its points scaled to their sizes (to a tenth
-    of a pixel), and only what training reads (the ordered pairs' points and labels),
-    which is about a third of the file: every MiB counts against the transfer limit."""
+def scaled_ordinal_set(ordinal: Path, photos_root: Path) -> dict:
+    """The ordinal set for the carried photos under photos_root: its points scaled from
+    each photo's size in the set (upright, as labelled) to the carried one (to a tenth of
+    a pixel), and only what training reads (the ordered pairs' points and labels)."""
     data = json.loads(Path(ordinal).read_text())
     photos = []
     for entry in data["photos"]:
-        if entry["photo"] not in sizes:
-            raise SystemExit(photo_folder.missing_photo(ordinal, entry["photo"], photo_folder.photo_root()))
-        sx, sy, w, h = sizes[entry["photo"]]
+        try:
+            with Image.open(photos_root / entry["photo"]) as carried:
+                w, h = carried.size
+        except OSError:
+            raise SystemExit(photo_folder.missing_photo(ordinal, entry["photo"], photos_root))
+        sx, sy = w / entry["width"], h / entry["height"]
 
         def scaled(point):  # pixel centres scaled, kept inside the carried photo
             x, y = point
@@ -174,7 +178,7 @@ def pack_planes(out: Path, sizes, disparity_dir: str) -> int:
     """The plane map of every photo with a cached disparity map, at its carried size (the
     maps themselves would take several times the room); returns how many."""
     count = 0
-    for rel, (_, _, w, h) in sizes.items():
+    for rel, (w, h) in sizes.items():
         source = Path(inpaint_data.disparity_path(disparity_dir, rel))
         if source.exists():
             inpaint_data.write_planes(str(source), (w, h), inpaint_data.disparity_path(str(out), rel))
@@ -233,16 +237,18 @@ def inpaint_command(args, workers: int) -> str:
             f"{shlex.join(shlex.split(args.inpaint_args))}")
 
 
-def train_script(args, names, teacher_weights) -> str:
-    """The shell script the GPU machine runs from the repository's root: the teacher's
-    labels first (with --teacher), then every run's training side by side, then its slim
-    checkpoint, best weights and logs into $OUT/NAME/. The training gets --minutes or
+def train_script(args, names, ordinal, teacher_weights) -> str:
+    """The shell script the GPU machine runs from the repository's root: the ordinal set
+    scaled to the carried photos first, the teacher's labels next (with --teacher), then
+    every run's training side by side, then its slim checkpoint, best weights and logs
+    into $OUT/NAME/. The training gets --minutes or
     what the call has left after the teacher and before the hand-back, whichever is less:
     a call the device tool stops at its limit brings nothing back."""
     c, workers = args.carry, max(1, args.workers // len(names))
     lines = ["#!/bin/bash", "# written by training/gpu_run.py pack", "set -u",
              f"export AMPI_PHOTO_ROOT={c}/photos PYTHONUNBUFFERED=1", "pids=()",
-             f"deadline=$(( $(date +%s) + {args.call_seconds - HANDBACK_SECONDS} ))"]
+             f"deadline=$(( $(date +%s) + {args.call_seconds - HANDBACK_SECONDS} ))",
+             f"{args.python} training/gpu_run.py ordinal {ordinal} {c}/photos {c}/ordinal.json || exit 1"]
     if teacher_weights:
         lines.append(f"{teacher_command(args, teacher_weights)} > {c}/teacher.txt 2>&1 "
                      f"|| {{ tail -n 20 {c}/teacher.txt; exit 1; }}")
@@ -280,16 +286,17 @@ def cmd_pack(args):
     if carry.exists():
         shutil.rmtree(carry)
     sizes = pack_photos(carry / "photos")
-    (carry / "ordinal.json").write_text(json.dumps(scaled_ordinal_set(args.ordinal, sizes), separators=(",", ":")))
     planes = pack_planes(carry / "inpaint_planes", sizes, args.disparity_dir) if INPAINT in dict(runs) else 0
     tracked = tracked_files()
+    ordinal = carried_file(Path(args.ordinal), carry / "ordinal_set", f"{args.carry}/ordinal_set", tracked)
+    scaled_ordinal_set(Path(args.ordinal), carry / "photos")   # fails here what would fail there
     teacher_weights = carried_teacher(args, carry, tracked) if args.teacher else None
     for name, run in runs:
         (carry / name).mkdir(parents=True)
         checkpoint = run_files(name).checkpoint
         if (run / checkpoint).exists():  # best.pt stays here: the GPU writes one only if it beats it
             slim_checkpoint(run / checkpoint, carry / name / checkpoint)
-    (carry / "train.sh").write_text(train_script(args, [name for name, _ in runs], teacher_weights))
+    (carry / "train.sh").write_text(train_script(args, [name for name, _ in runs], ordinal, teacher_weights))
     parts = {part.name: size_of(part) for part in sorted(carry.iterdir())}
     tree = sum(path.stat().st_size for path in tracked)
     total = tree + sum(parts.values())
@@ -311,20 +318,35 @@ def tracked_files() -> list:
 
 
 def carried_teacher(args, carry: Path, tracked: list) -> str:
-    """The teacher's weights as the GPU machine finds them: a file of the working tree
-    (`tracked`, as tracked_files() lists it: the bundled weights) travels with it; any
-    other is copied into the carried folder."""
-    weights = Path(args.teacher).resolve()
+    """The teacher's weights as the GPU machine finds them (carried_file: the bundled
+    weights travel with the working tree)."""
+    weights = Path(args.teacher)
     if weights.suffix != ".ampw" or not weights.is_file():
         raise SystemExit(f"--teacher {args.teacher}: expected a depth network's .ampw file (export_depth.py)")
-    if weights in tracked:
-        return weights.relative_to(ROOT).as_posix()
-    (carry / "teacher_weights").mkdir()
-    shutil.copyfile(weights, carry / "teacher_weights" / weights.name)
-    return f"{args.carry}/teacher_weights/{weights.name}"
+    return carried_file(weights, carry / "teacher_weights", f"{args.carry}/teacher_weights", tracked)
 
 
-# ---- slim, unpack ---------------------------------------------------------------------------
+def carried_file(path: Path, folder: Path, there: str, tracked: list) -> str:
+    """Where the GPU machine finds the file at path, for commands run from the
+    repository's root: a file of the working tree (`tracked`, as tracked_files() lists
+    it) travels with it; any other is copied into folder, a folder of the carried one,
+    which the GPU machine finds at `there`."""
+    path = path.resolve()
+    if not path.is_file():
+        raise SystemExit(f"{path}: no such file to carry")
+    if path in tracked:
+        return path.relative_to(ROOT).as_posix()
+    folder.mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(path, folder / path.name)
+    return f"{there}/{path.name}"
+
+
+# ---- ordinal and slim (there), unpack ------------------------------------------------------------
+
+def cmd_ordinal(args):
+    scaled = scaled_ordinal_set(Path(args.ordinal), Path(args.photos))
+    Path(args.out).write_text(json.dumps(scaled, separators=(",", ":")))
+
 
 def cmd_slim(args):
     slim_checkpoint(Path(args.source), Path(args.target))
@@ -412,11 +434,15 @@ def main(argv=None):
     unpack = sub.add_parser("unpack", help="the files that came back into the run folders")
     unpack.add_argument("files_at")
     unpack.add_argument("--run", action="append", required=True, help="NAME:DIR, as given to pack")
+    ordinal = sub.add_parser("ordinal", help="(train.sh, there) the ordinal set scaled to the carried photos")
+    ordinal.add_argument("ordinal", help="the ordinal set (training/ordinal/ordinal.json)")
+    ordinal.add_argument("photos", help="the carried photos' folder, with the set's relative names")
+    ordinal.add_argument("out", help="the scaled set to write, for train_depth.py --ordinal")
     slim = sub.add_parser("slim", help="a checkpoint without Adam's moments")
     slim.add_argument("source")
     slim.add_argument("target")
     args = p.parse_args(argv)
-    {"pack": cmd_pack, "unpack": cmd_unpack, "slim": cmd_slim}[args.command](args)
+    {"pack": cmd_pack, "unpack": cmd_unpack, "ordinal": cmd_ordinal, "slim": cmd_slim}[args.command](args)
 
 
 if __name__ == "__main__":

@@ -87,17 +87,12 @@ class RoundTrip(unittest.TestCase):
                                         "--teacher-resolutions", "64,96",
                                         "--inpaint-args=--max-photos 3 --batch 2 --crop 64 --log-every 2 "
                                         "--validate-every 2 --checkpoint-every 2", env=env)
-                packed = json.loads((carry / "ordinal.json").read_text())["photos"][0]
-                self.assertEqual((packed["width"], packed["height"]), (384, 128))   # scaled to 384 px
                 with Image.open(carry / "photos" / "set" / "p0.jpg") as photo:
                     self.assertEqual(photo.size, (384, 128))
-                self.assertLess(packed["pairs"][0]["b"][0], 384)
-                # only the ordered pair, its label and its points (pixel centres scaled, kept inside)
-                [pair] = packed["pairs"]
-                self.assertEqual(set(pair), {"label", "a", "b"})
-                scale = 384 / 900
-                self.assertEqual(pair["a"], [round(10.5 * scale - 0.5, 1), round(290.5 * scale - 0.5, 1)])
-                self.assertEqual(pair["b"], [383, round(0.5 * scale - 0.5, 1)])
+                # the set is outside the working tree, so it is carried; train.sh scales it there
+                self.assertEqual((carry / "ordinal_set" / "ordinal.json").read_text(),
+                                 (tmp / "ordinal.json").read_text())
+                self.assertFalse((carry / "ordinal.json").exists())
                 self.check_plane_map(carry, tmp / "disparity")
                 self.assertIn("--lr-decay cosine --decay-steps 1000", (carry / "train.sh").read_text())
                 command = printed.strip().splitlines()[-1]
@@ -106,6 +101,7 @@ class RoundTrip(unittest.TestCase):
                 done = subprocess.run(["bash", "-c", command], cwd=ROOT, env=dict(env, OUT=str(out)),
                                       capture_output=True, text=True)
                 self.assertEqual(done.returncode, 0, done.stdout + done.stderr)
+                self.check_scaled_ordinal_set(carry)
                 self.check_teacher_labels(carry)
                 self.run_tool("unpack", str(out), *run_args)
                 for name in ("checkpoint.pt", "best.pt", "train.log"):
@@ -131,6 +127,32 @@ class RoundTrip(unittest.TestCase):
             self.assertIn("ordinal_whdr", log)
             self.assertEqual(log.count(f"teacher's labels {carry}/teacher weight 0.5"), 2)
             self.check_inpaint_logs(runs["inpaint"])
+
+    def check_scaled_ordinal_set(self, carry: Path):
+        """train.sh scaled the set's points to the carried photos, 384 px long, and kept
+        only the ordered pairs, each with its label and points (pixel centres scaled, kept
+        inside the photo)."""
+        packed = json.loads((carry / "ordinal.json").read_text())["photos"][0]
+        self.assertEqual((packed["width"], packed["height"]), (384, 128))
+        [pair] = packed["pairs"]
+        self.assertEqual(set(pair), {"label", "a", "b"})
+        scale = 384 / 900
+        self.assertEqual(pair["a"], [round(10.5 * scale - 0.5, 1), round(290.5 * scale - 0.5, 1)])
+        self.assertEqual(pair["b"], [383, round(0.5 * scale - 0.5, 1)])
+
+    def test_the_bundled_ordinal_set_travels_with_the_tree(self):
+        """pack carries no copy of training/ordinal/ordinal.json (the working tree holds it),
+        and refuses a set naming a photo it has not carried."""
+        tracked = gpu_run.tracked_files()
+        with tempfile.TemporaryDirectory() as folder:
+            carry = Path(folder) / "carry"
+            self.assertEqual(gpu_run.carried_file(gpu_run.ORDINAL, carry / "ordinal_set", "carry/ordinal_set", tracked),
+                             "training/ordinal/ordinal.json")
+            self.assertFalse(carry.exists())
+            make_photos(Path(folder))
+            (Path(folder) / "photos" / "set" / "p3.jpg").unlink()
+            with self.assertRaisesRegex(SystemExit, r"ordinal.json: set/p3.jpg is not under .*photos$"):
+                gpu_run.scaled_ordinal_set(Path(folder) / "ordinal.json", Path(folder) / "photos")
 
     def check_teacher_labels(self, carry: Path):
         """The GPU machine labelled every carried photo with the carried teacher's
