@@ -341,7 +341,7 @@ def carried_file(path: Path, folder: Path, there: str, tracked: list) -> str:
     return f"{there}/{path.name}"
 
 
-# ---- ordinal and slim (there), unpack ------------------------------------------------------------
+# ---- ordinal and slim (there), unpack -------------------------------------------------------
 
 def cmd_ordinal(args):
     scaled = scaled_ordinal_set(Path(args.ordinal), Path(args.photos))
