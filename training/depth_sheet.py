@@ -1,7 +1,7 @@
 """Contact sheet of the validation photos (every tenth photo, never trained on) with the
 disparity a bundled depth network predicts for them: what a user would see.
 
-    /usr/bin/python3 training/depth_sheet.py weights/depth_lite.ampw training/depth_val_sheet.png
+    /usr/bin/python3 training/depth_sheet.py weights/depth_lite.ampw training/depth_val_sheet.jpg
 
 The network runs at the working size its weight file records (as `ampi depth` does), on
 the photo scaled so its long side is that size and padded to the network's multiple; the
@@ -84,7 +84,7 @@ def main(argv=None):
     for path in chosen:
         rgb = photo_folder.load_photo(path, max_side=1024)
         tiles.append(tile_pair(rgb, predict(model, rgb, long_side, multiple)))
-    Image.fromarray(sheet(tiles, args.columns)).save(args.output, optimize=True)
+    Image.fromarray(sheet(tiles, args.columns)).save(args.output, optimize=True, quality=90)  # quality: JPEG only
     print(f"{args.output}: {len(tiles)} validation photos, {Path(args.weights).name} at long side {long_side}")
 
 

@@ -88,7 +88,8 @@ def ordinal_split(path):
 
 
 def photo_root():
-    return Path(os.environ.get('AMPI_PHOTO_ROOT', DEFAULT_PHOTO_ROOT))
+    # an empty AMPI_PHOTO_ROOT (`export AMPI_PHOTO_ROOT=`) is unset, not the current folder
+    return Path(os.environ.get('AMPI_PHOTO_ROOT') or DEFAULT_PHOTO_ROOT)
 
 
 def missing_photo(source, photo, root):

@@ -11,7 +11,7 @@ shadows, hazed with distance, and passed through a random camera (defocus, optic
 softness, white balance, gamma, noise, JPEG).
 
     /usr/bin/python3 training/scenes.py --bench
-    /usr/bin/python3 training/scenes.py --contact-sheet training/scenes_contact_sheet.png
+    /usr/bin/python3 training/scenes.py --contact-sheet training/scenes_contact_sheet.jpg
 
 The stages live beside this file: scene_sampler.py draws a scene from a seed,
 raytracer.py renders it (with shapes.py and textures.py), camera_effects.py makes the
@@ -102,7 +102,7 @@ def contact_sheet(path, seeds, tile=(192, 144), columns=3):
         for j, picture in enumerate((rgb, colour_disparity(disparity))):
             small = Image.fromarray(picture).resize(tile, Image.BILINEAR, reducing_gap=2.0)
             sheet[y:y + th, x + j * tw:x + (j + 1) * tw] = np.asarray(small)
-    Image.fromarray(sheet).save(path, optimize=True)
+    Image.fromarray(sheet).save(path, optimize=True, quality=90)  # quality: JPEG only
 
 
 def benchmark(count, workers, size):
