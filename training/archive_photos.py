@@ -5,15 +5,16 @@ reaches).
     /usr/bin/python3 training/archive_photos.py      # -> training/data_cache/photos
 
 Makes training/data_cache/photos, a photo root for training (AMPI_PHOTO_ROOT, --images):
-a link to each folder of ../shared/data/photos, and the folder archive/ with the 184
-photographs listed below, taken from seven Debian packages (`apt-get download`, `dpkg -x`;
+a link to each folder of ../shared/data/photos, and the folder archive/ with the 251
+photographs listed below, taken from nineteen Debian packages (`apt-get download`, `dpkg -x`;
 no root needed; gcompris-qt-data's photos read out of its Qt resource files), long side
 brought to at most MAX_SIDE. Nothing goes into git.
 
 No archive photo is a validation photo (photo_folder.NO_VALIDATION_FOLDERS): the
 validation and test photos stay those of ../shared, so every WHDR measured before
-still compares. They train, but for half of the last three packages' photos, the ordinal
-set's holdout (photo_folder.HOLDOUT_PREFIXES). Idempotent: photos already there are kept,
+still compares. They train, but for half of the photos of each of the two later groups
+of packages, the ordinal set's holdout (photo_folder.HOLDOUT_GROUPS). Idempotent: photos
+already there are kept,
 packages already downloaded are not fetched again.
 
 Which images: every photograph of a three-dimensional scene in these packages, chosen
@@ -26,7 +27,14 @@ every illustration and render of plasma-workspace-wallpapers, mate-backgrounds' 
 abstract folders (graphics, and Elephants, a painting), and gcompris-qt-data's images below
 800 px on the long side (categorization, details and the like: 320-700 px), which were not
 looked at. Packages looked at and left out whole: gnome-backgrounds (renders), ukui-wallpapers
-(illustrations), sway-backgrounds (logos).
+(illustrations), sway-backgrounds (logos). The last group (palapeli-data to gimp-help-en,
+67 photos) came from a search of about forty packages (documentation, games, login and
+desktop themes), every image of 600 px or more looked at on contact sheets by a helper
+agent: left out were screenshots, cut-outs, flat textures and illustrations (desktop-base,
+xfdesktop4-data, the other sddm themes, fotoxx, kdenlive and the rest had nothing else),
+and, within the packages kept, photos with little depth to order (a sunset, the moon behind
+branches, a flower or a pizza filling the frame, a Mars sky) and the four KPhotoAlbum demo
+photos whose rotation lives outside the file.
 """
 
 import io
@@ -118,6 +126,40 @@ SOURCES = [
      GCOMPRIS_LICENCE),
     ('gcompris-qt-data', 'usr/share/gcompris-qt/rcc/clickgame.rcc/gcompris/src/activities/clickgame/resource',
      'gcompris_sea', [f'sea{k}.webp' for k in range(1, 7)], GCOMPRIS_LICENCE),
+    # and these later still (photo_folder.HOLDOUT_GROUPS' second group): photos found in
+    # documentation, games and themes, looked at as contact sheets
+    ('palapeli-data', 'usr/share/palapeli/collection', 'palapeli', [
+        'castle-maintenon.jpg', 'cincinnati-bridge.jpg', 'european-honey-bee.jpg',
+        'panther-chameleon-female.jpg'], 'GPL-2+ (the package\'s Files: *)'),
+    ('python3-sklearn', 'usr/lib/python3/dist-packages/sklearn/datasets/images', 'sklearn', [
+        'china.jpg'], 'BSD-3-Clause'),
+    ('scribus-template', 'usr/share/scribus/templates', 'scribus', [
+        'br2/nature.jpg', 'br2/sunset.jpg'], 'public domain (Riku Leino\'s templates)'),
+    ('sddm-theme-maldives', 'usr/share/sddm/themes/maldives', 'sddm_maldives', [
+        'background.jpg'], 'CC-BY-3.0'),
+    ('tuxpaint-data', 'usr/share/tuxpaint/templates', 'tuxpaint', [f'{name}.jpg' for name in (
+        'cliff', 'corn_maze', 'jellyfish', 'lighthouse', 'mossy_log', 'mudstone', 'ocean_waves',
+        'redwoods_above', 'rocks', 'sheep', 'spiders_web', 'sun_behind_leaves', 'trees_above',
+        'wool_mill_machine')], 'GPL-2+ (the package\'s Files: *)'),
+    ('lxqt-themes', 'usr/share/lxqt/wallpapers', 'lxqt', [
+        'Butterfly-Kenneth-Wimer.jpg', 'Valendas.png', 'appleflower.png', 'beam.png', 'butterfly.png',
+        'drop.png', 'flowers.png', 'fog.jpg', 'this-is-not-windows.jpg'], 'CC-BY-SA-3.0 (its License file)'),
+    ('tuxtype-data', 'usr/share/tuxtype/images', 'tuxtype', [
+        *(f'kcas{k}.jpg' for k in range(12)), 'hidden.jpg'], 'GPL (the package\'s copyright file)'),
+    ('digikam-data', 'usr/share/digikam/about/images', 'digikam', ['body-background.jpg'], 'GPL-2'),
+    ('hugin-data', 'usr/share/hugin/xrc/data/help_en_EN', 'hugin', [
+        'CA_fringes00.jpg', 'CA_tCA00.jpg'], 'GPL-2+'),
+    # KPhotoAlbum's demo keeps four photos' rotation in its index.xml, not in the JPEG:
+    # grand_canyon_1, new_wave_1, pool_2 and wayne are left out rather than guessed upright
+    ('kphotoalbum', 'usr/share/kphotoalbum/demo', 'kphotoalbum', [f'{name}.jpg' for name in (
+        'anne_helene', 'bar55', 'bar55_2', 'blackie', 'cold_water', 'donna', 'donna_2', 'grand_canyon_2',
+        'grand_canyon_3', 'jesper_2', 'new_wave_2', 'pool', 'skagen', 'skagen_2', 'snow', 'spiff',
+        'spiff_2')], 'GPL-2'),
+    ('puzzle-jigsaw', 'usr/share/puzzle-jigsaw/samples', 'jigsaw', [
+        ('pexels-photo-302304.jpeg', 'tiger.jpg')], 'CC0-1.0'),
+    ('gimp-help-en', 'usr/share/gimp/2.0/help/en/images/tutorials/tone-mapping', 'gimphelp', [
+        ('truck-tone-mapped-using-gegl-mantuik.jpg', 'truck.jpg'), 'power-lines.jpg'],
+     'GFDL (the GIMP manual)'),
 ]
 
 

@@ -5,7 +5,7 @@ repository. Splits go by a photo's place in its folder's sorted names, so that a
 the folder with the same names (gpu_run.py's downscaled one) splits the same way: every
 tenth photo is validation (photo_split), every fifth is the real-photo ordinal validation
 (ordinal_split, a superset of the former). Every second of the archive photos labelled
-last is the ordinal set's 'holdout' part (HOLDOUT_PREFIXES). Scene seeds split too
+last is the ordinal set's 'holdout' part (HOLDOUT_GROUPS). Scene seeds split too
 (is_validation_seed): validation scenes are textured only with validation photos.
 """
 
@@ -26,12 +26,18 @@ ORDINAL_VALIDATION_PERIOD = 5     # every fifth: the real-photo ordinal validati
 # but for the holdout below.
 ARCHIVE_FOLDER = 'archive'
 NO_VALIDATION_FOLDERS = {ARCHIVE_FOLDER}
-# The archive photos labelled last (plasma-workspace-wallpapers', mate-backgrounds' and
-# gcompris-qt-data's), after every bundled network had been trained and picked: no pick has
-# seen them, unlike the val/test photos, picked on round after round. Every second of them
-# by sorted name is the 'holdout' part of the ordinal set: never trained on, never picked
-# on, scored only to judge a pick. The other half trains.
-HOLDOUT_PREFIXES = ('gcompris_', 'mate_', 'plasma_')
+# Archive photos added after every bundled network had been trained and picked, in two
+# groups (plasma-workspace-wallpapers', mate-backgrounds' and gcompris-qt-data's; then the
+# photos of twelve documentation, game and theme packages): no pick has seen them, unlike
+# the val/test photos, picked on round after round. Every second photo of each group, by
+# sorted name among that group's photos, is the 'holdout' part of the ordinal set: never
+# trained on, never picked on, scored only to judge a pick. The other half trains. A new
+# group counts on its own, so the photos of the groups before it keep their parts.
+HOLDOUT_GROUPS = (
+    ('gcompris_', 'mate_', 'plasma_'),
+    ('digikam_', 'gimphelp_', 'hugin_', 'jigsaw_', 'kphotoalbum_', 'lxqt_', 'palapeli_', 'scribus_',
+     'sddm_maldives_', 'sklearn_', 'tuxpaint_', 'tuxtype_'),
+)
 HOLDOUT_PERIOD = 2
 
 
@@ -64,10 +70,10 @@ def _without_validation(path):
 
 
 def _holdout(path):
-    """True for every HOLDOUT_PERIOD-th archive photo named with a HOLDOUT_PREFIXES prefix,
-    counted among those photos by sorted name."""
-    return (Path(path).name.startswith(HOLDOUT_PREFIXES)
-            and _every_nth_of_folder(path, HOLDOUT_PERIOD, HOLDOUT_PREFIXES))
+    """True for every HOLDOUT_PERIOD-th archive photo of a HOLDOUT_GROUPS group, counted
+    among that group's photos by sorted name."""
+    return any(Path(path).name.startswith(group) and _every_nth_of_folder(path, HOLDOUT_PERIOD, group)
+               for group in HOLDOUT_GROUPS)
 
 
 def photo_split(path):

@@ -273,17 +273,19 @@ class ValidationSplit(unittest.TestCase):
                 self.assertEqual({split(p) for p in photos if p.parent.name == 'archive'}, {'train'})
 
     def test_every_second_archive_photo_labelled_last_is_holdout(self):
-        """Counted among the HOLDOUT_PREFIXES photos alone, by sorted name; the other
-        archive photos train, and photo_split (the synthetic validation) is unchanged."""
+        """Counted among each HOLDOUT_GROUPS group's photos alone, by sorted name, so a
+        later group leaves the earlier ones' parts as they were; the other archive photos
+        train, and photo_split (the synthetic validation) is unchanged."""
         with tempfile.TemporaryDirectory() as tmp:
             archive = Path(tmp) / 'archive'
             archive.mkdir()
-            names = ['a_photo.jpg', 'gcompris_x.jpg', 'lomiri_y.jpg', 'mate_z.jpg', 'plasma_1.jpg',
-                     'plasma_2.png', 'zz.jpg']
+            names = ['a_photo.jpg', 'gcompris_x.jpg', 'hugin_a.jpg', 'kphotoalbum_b.jpg', 'lomiri_y.jpg',
+                     'mate_z.jpg', 'plasma_1.jpg', 'plasma_2.png', 'tuxtype_c.jpg', 'zz.jpg']
             for name in names:
                 (archive / name).write_bytes(b'')
             ordinal = {name: photo_folder.ordinal_split(archive / name) for name in names}
-            self.assertEqual(sorted(n for n, s in ordinal.items() if s == 'holdout'), ['mate_z.jpg', 'plasma_2.png'])
+            self.assertEqual(sorted(n for n, s in ordinal.items() if s == 'holdout'),
+                             ['kphotoalbum_b.jpg', 'mate_z.jpg', 'plasma_2.png'])
             self.assertEqual(set(ordinal.values()), {'train', 'holdout'})
             self.assertEqual({photo_folder.photo_split(archive / n) for n in names}, {'train'})
 
