@@ -14,9 +14,9 @@ The GPU machine gets only the working tree and the carried folder (64 MiB in all
 ../shared: `pack` writes every photo at PHOTO_LONG_SIDE (JPEG) under carry/photos with the
 same folder and file names, so the train/validation splits are the same there; train.sh
 first scales the ordinal set's points to those sizes there (`gpu_run.py ordinal`), from
-the set that travels with the working tree, so that only one copy of it takes room. The inpainting run trains on the same
-photos, so at most 384 px there against inpaint_data.MAX_SIDE = 768 here: a photo of 768
-px or more is seen at half the scale. For each photo with a cached disparity map
+the set that travels with the working tree, so that only one copy of it takes room. The
+inpainting run trains on the same photos, so at most 384 px there against
+inpaint_data.MAX_SIDE = 768 here: a photo of 768 px or more is seen at half the scale. For each photo with a cached disparity map
 (--disparity-dir) it gets the plane map its slicing would make of that map at the carried
 size (inpaint_data.write_planes; the maps themselves would not fit); the others get the
 stand-in there as here. `pack` prints what each part of the transfer takes and fails,
