@@ -99,7 +99,7 @@ def depth_table(ampi, count, threads):
     return '\n'.join(lines)
 
 
-ORDINAL_SET = REPO / 'training' / 'ordinal' / 'ordinal.json'
+ORDINAL_SET = REPO / 'training' / 'ordinal' / 'ordinal.json.gz'
 ORDINAL_SPLITS = ('val', 'test', 'holdout', 'train')
 SECTION_SPLITS = ('val', 'test')  # the sections' splits; holdout is kept for judging picks
 
@@ -227,7 +227,7 @@ def working_size_section(ampi, threads, root):
         'Both networks were trained on 256x192 crops and are run with the long side at 256',
         '(their files\' `depth.working_long_side`). `--working-size N` runs them at another',
         'long side; each cell is the WHDR row of `ampi eval depth --images PHOTOS --ordinal',
-        'training/ordinal/ordinal.json --split SPLIT --model MODEL --working-size N`.',
+        'training/ordinal/ordinal.json.gz --split SPLIT --model MODEL --working-size N`.',
         'A larger working size does not order depth better: each network orders best at the',
         'frame size it was trained at.',
         '',

@@ -27,7 +27,8 @@ struct OrdinalPhoto {
   std::vector<OrdinalPair> pairs;
 };
 
-// Reads an ordinal set (training/ordinal/ordinal.json). Throws std::runtime_error
+// Reads an ordinal set (training/ordinal/ordinal.json.gz; OpenCV's FileStorage reads a name
+// ending in .gz as gzip). Throws std::runtime_error
 // "PATH: problem" for an unreadable or malformed file (missing field, label other than
 // A, B or =, point outside its photo).
 std::vector<OrdinalPhoto> read_ordinal_set(const std::string& path);

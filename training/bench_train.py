@@ -29,7 +29,7 @@ import train_depth  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 TABLE = HERE / "BENCH_TRAIN.md"
-ORDINAL = HERE / "ordinal" / "ordinal.json"
+ORDINAL = HERE / "ordinal" / "ordinal.json.gz"
 
 
 def configurations(cores: int):

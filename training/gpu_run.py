@@ -69,7 +69,7 @@ ROOT = Path(__file__).resolve().parents[1]
 PHOTO_LONG_SIDE = 384
 PHOTO_QUALITY = 70   # JPEG: 6.4 MiB for the 309 photos (7.0 at 75), against the transfer limit
 TRANSFER_LIMIT = 64 * 2 ** 20   # the device tool's working tree, carried folder included
-ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json"
+ORDINAL = ROOT / "training" / "ordinal" / "ordinal.json.gz"
 INPAINT = "inpaint"
 TEACHER_LABELS = "teacher"   # the teacher's label folder under the carried folder, made there
 NETWORKS = (*depth_model.ARCHITECTURES, INPAINT)   # what --run NAME:DIR may name
@@ -154,7 +154,7 @@ def scaled_ordinal_set(ordinal: Path, photos_root: Path) -> dict:
     """The ordinal set for the carried photos under photos_root: its points scaled from
     each photo's size in the set (upright, as labelled) to the carried one (to a tenth of
     a pixel), and only what training reads (the ordered pairs' points and labels)."""
-    data = json.loads(Path(ordinal).read_text())
+    data = photo_folder.read_json(ordinal)
     photos = []
     for entry in data["photos"]:
         try:
@@ -435,7 +435,7 @@ def main(argv=None):
     unpack.add_argument("files_at")
     unpack.add_argument("--run", action="append", required=True, help="NAME:DIR, as given to pack")
     ordinal = sub.add_parser("ordinal", help="(train.sh, there) the ordinal set scaled to the carried photos")
-    ordinal.add_argument("ordinal", help="the ordinal set (training/ordinal/ordinal.json)")
+    ordinal.add_argument("ordinal", help="the ordinal set (training/ordinal/ordinal.json.gz)")
     ordinal.add_argument("photos", help="the carried photos' folder, with the set's relative names")
     ordinal.add_argument("out", help="the scaled set to write, for train_depth.py --ordinal")
     slim = sub.add_parser("slim", help="a checkpoint without Adam's moments")

@@ -10,7 +10,7 @@ edge-replicated to the network's multiple), once as it is and once mirrored, the
 disparity mirrored back before the pairs are read. Every file was picked by its WHDR on `val` as the
 photos are (train_depth.py --ordinal), never mirrored, so the gap between the two columns
 on `val` and `test` is partly that choice; on photos no choice has seen it is the network's
-own left-right bias alone. The subset of ordinal.json for the photos no bundled file
+own left-right bias alone. The subset of the ordinal set for the photos no bundled file
 trained on: training/ordinal/pairs.py subset.
 """
 import argparse

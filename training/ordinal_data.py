@@ -1,4 +1,4 @@
-"""Real photos with labelled point pairs (training/ordinal/ordinal.json) for training and
+"""Real photos with labelled point pairs (training/ordinal/ordinal.json.gz) for training and
 validating the depth networks: the ranking loss and WHDR.
 
 The ranking loss is Chen et al. 2016's ("Single-Image Depth Perception in the Wild") for
@@ -9,7 +9,6 @@ prediction orders wrongly, a tie counting half, as `ampi eval depth --ordinal` r
 """
 from __future__ import annotations
 
-import json
 import random
 from pathlib import Path
 
@@ -21,8 +20,8 @@ from PIL import Image, ImageOps
 import distill
 import photo_folder
 
-ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json"
-SPLITS = ("train", "val", "test", "holdout")  # an ordinal.json photo entry's parts (training/ordinal/README.md)
+ORDINAL_FILE = Path(__file__).resolve().parent / "ordinal" / "ordinal.json.gz"
+SPLITS = ("train", "val", "test", "holdout")  # an ordinal set's photo entry's parts (training/ordinal/README.md)
 PHOTO_MAX_SIDE = 640      # photos are kept decoded at this size (training crops are smaller)
 CROP_SHARE = (0.7, 1.0)   # a training crop keeps this share of each side
 WIDE_CROP_SHARE = (0.5, 1.0)  # train_depth.py --photo-augment: more zoom, more views of few photos
@@ -40,14 +39,14 @@ def validation_photos(photo_root: Path, ordinal_file: Path = ORDINAL_FILE) -> se
     """Resolved paths of every photo of the validation split (its test part included) and
     of the holdout, labelled pairs or not: no other training data may show them
     (train_depth.py's distilled source leaves them out)."""
-    entries = json.loads(Path(ordinal_file).read_text())["photos"]
+    entries = photo_folder.read_json(ordinal_file)["photos"]
     return {(Path(photo_root) / e["photo"]).resolve() for e in entries if e["split"] in ("val", "test", "holdout")}
 
 
 def load_split(split: str, photo_root: Path, ordinal_file: Path = ORDINAL_FILE, teacher_labels=None):
     """The photos of one split ('train', 'val', 'test' or 'holdout') with their ordered pairs, and
     with teacher_labels (an `ampi distill` label folder of photo_root) each photo's label."""
-    entries = json.loads(Path(ordinal_file).read_text())["photos"]
+    entries = photo_folder.read_json(ordinal_file)["photos"]
     teacher = TeacherLabels(teacher_labels, photo_root) if teacher_labels else None
     photos = []
     for entry in entries:

@@ -10,6 +10,8 @@ last is the ordinal set's 'holdout' part (HOLDOUT_GROUPS). Scene seeds split too
 """
 
 import functools
+import gzip
+import json
 import os
 from pathlib import Path
 
@@ -96,6 +98,14 @@ def ordinal_split(path):
 def photo_root():
     # an empty AMPI_PHOTO_ROOT (`export AMPI_PHOTO_ROOT=`) is unset, not the current folder
     return Path(os.environ.get('AMPI_PHOTO_ROOT') or DEFAULT_PHOTO_ROOT)
+
+
+def read_json(path):
+    """A JSON file of photo names and points (the pair file, an ordinal set), gzip-compressed
+    when its name ends in .gz: the bundled ones are, since they travel to GPU machines with
+    the working tree against a transfer limit."""
+    data = Path(path).read_bytes()
+    return json.loads(gzip.decompress(data) if Path(path).suffix == '.gz' else data)
 
 
 def missing_photo(source, photo, root):

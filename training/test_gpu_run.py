@@ -141,13 +141,13 @@ class RoundTrip(unittest.TestCase):
         self.assertEqual(pair["b"], [383, round(0.5 * scale - 0.5, 1)])
 
     def test_the_bundled_ordinal_set_travels_with_the_tree(self):
-        """pack carries no copy of training/ordinal/ordinal.json (the working tree holds it),
+        """pack carries no copy of training/ordinal/ordinal.json.gz (the working tree holds it),
         and refuses a set naming a photo it has not carried."""
         tracked = gpu_run.tracked_files()
         with tempfile.TemporaryDirectory() as folder:
             carry = Path(folder) / "carry"
             self.assertEqual(gpu_run.carried_file(gpu_run.ORDINAL, carry / "ordinal_set", "carry/ordinal_set", tracked),
-                             "training/ordinal/ordinal.json")
+                             "training/ordinal/ordinal.json.gz")
             self.assertFalse(carry.exists())
             make_photos(Path(folder))
             (Path(folder) / "photos" / "set" / "p3.jpg").unlink()

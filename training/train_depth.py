@@ -22,7 +22,7 @@ Data sources (--data), all yielding (rgb, disparity) pairs, rgb in [0, 1]:
 Validation uses a disjoint fixed set: scene seeds from VAL_SEED_START, or every tenth
 pair by sorted name (never trained on).
 
-Real photos (--ordinal training/ordinal/ordinal.json): each step also takes
+Real photos (--ordinal training/ordinal/ordinal.json.gz): each step also takes
 --ordinal-batch photos of the set's training split (random crops, flips; wider crops
 and colour jitter with --photo-augment) with the ranking loss of their labelled pairs
 (training/ordinal_data.py), weighted by --rank-weight, beside the paper's loss on the
@@ -593,7 +593,7 @@ def main(argv=None):
     p.add_argument("--scene-reuse", type=int, default=1,
                    help="steps each rendered scene batch trains, augmented after the first (a GPU's setting)")
     p.add_argument("--workers", type=int, default=1, help="processes making batches ahead (0: in the loop)")
-    p.add_argument("--ordinal", help="ordinal set (training/ordinal/ordinal.json): ranking loss on its "
+    p.add_argument("--ordinal", help="ordinal set (training/ordinal/ordinal.json.gz): ranking loss on its "
                                      "training photos, WHDR on its validation photos")
     p.add_argument("--ordinal-batch", type=int, default=4, help="real photos per step with --ordinal")
     p.add_argument("--rank-weight", type=float, default=1.0, help="weight of the ranking loss")

@@ -99,6 +99,15 @@ if "$ampi" eval depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --thr
 else
   fail "eval depth --ordinal: exit status $?: $(cat "$tmp/err")"
 fi
+# The bundled set is gzip-compressed (training/ordinal/ordinal.json.gz): the same set
+# compressed must score the same.
+gzip -c "$tmp/ordinal.json" >"$tmp/ordinal.json.gz"
+if "$ampi" eval depth --images "$tmp/images" --ordinal "$tmp/ordinal.json.gz" --threads 2 >"$tmp/out_gz" 2>"$tmp/err"; then
+  cmp -s "$tmp/out" "$tmp/out_gz" && echo "ok: eval depth --ordinal reads a .gz set" ||
+    fail "ordinal: the .gz set scored differently: $(cat "$tmp/out_gz")"
+else
+  fail "eval depth --ordinal, .gz set: exit status $?: $(cat "$tmp/err")"
+fi
 expect_error "ordinal, empty split" "no photos in split train" \
   depth --images "$tmp/images" --ordinal "$tmp/ordinal.json" --split train
 expect_error "ordinal, empty test split" "no photos in split test" \

@@ -5,7 +5,7 @@ them by eye, and the merged label file.
     export AMPI_PHOTO_ROOT=training/data_cache/photos  # ../shared's photos and the archive's
     /usr/bin/python3 training/ordinal/pairs.py sample            # -> training/ordinal/pairs.json.gz
     /usr/bin/python3 training/ordinal/pairs.py draw --out /tmp/ordinal_marked [--round N] [--only REL...]
-    /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json
+    /usr/bin/python3 training/ordinal/pairs.py merge             # labels/*.tsv -> ordinal.json.gz
     /usr/bin/python3 training/ordinal/pairs.py subset OUT [--prefix archive/...] [--rounds 1-2] [--kind edge]
 
 (training/archive_photos.py makes that root; `sample` from ../shared alone would leave the
@@ -42,7 +42,7 @@ import photo_folder  # noqa: E402  (the photo listing and the split)
 HERE = Path(__file__).resolve().parent
 PAIRS_FILE = HERE / 'pairs.json.gz'   # gzip: it travels to GPU machines with the working tree
 LABELS_DIR = HERE / 'labels'
-ORDINAL_FILE = HERE / 'ordinal.json'
+ORDINAL_FILE = HERE / 'ordinal.json.gz'  # gzip too; the label files are what a review reads
 
 SEED = 2026
 RANDOM_PAIRS = 5
@@ -140,10 +140,9 @@ def sample_photo(path, rel):
 
 
 def write_set(path: Path, header: dict, photos: list):
-    """header's keys and the photos as JSON, one pair per line: a third of the size of an
-    indented dump (the set travels to GPU machines with the working tree, against a
-    transfer limit), and a label change is still a one-line diff. A path ending in .gz is
-    compressed (with no time stamp, so the same set makes the same bytes)."""
+    """header's keys and the photos as JSON, one pair per line (a third of the size of an
+    indented dump, and readable once decompressed). A path ending in .gz is compressed,
+    with no time stamp, so the same set makes the same bytes."""
     lines = [f' {json.dumps(k)}: {json.dumps(v)},' for k, v in header.items()] + [' "photos": [']
     for n, entry in enumerate(photos):
         fields = json.dumps({k: v for k, v in entry.items() if k != 'pairs'})[:-1]
@@ -158,7 +157,7 @@ def write_set(path: Path, header: dict, photos: list):
 
 def read_pairs(path: Path = PAIRS_FILE) -> list:
     """The photos of a pair file (PAIRS_FILE), each with its pairs."""
-    return json.loads(gzip.decompress(path.read_bytes()))['photos']
+    return photo_folder.read_json(path)['photos']
 
 
 def cmd_sample(args):
@@ -331,7 +330,7 @@ def subset(photos: list, prefixes, rounds, kind=None) -> list:
 
 
 def cmd_subset(args):
-    whole = json.loads(ORDINAL_FILE.read_text())
+    whole = photo_folder.read_json(ORDINAL_FILE)
     first, _, last = args.rounds.partition('-')
     photos = subset(whole['photos'], args.prefix, (int(first), int(last or first)), args.kind)
     write_set(Path(args.out), {k: v for k, v in whole.items() if k != 'photos'}, photos)
@@ -348,8 +347,8 @@ def main():
     d.add_argument('--round', type=int, default=ROUNDS, choices=range(1, ROUNDS + 1),
                    help='which round of pairs to mark (default the newest)')
     d.add_argument('--only', nargs='*', help='photos (relative names) to draw, default all')
-    sub.add_parser('merge', help='labels/*.tsv -> ordinal.json')
-    s = sub.add_parser('subset', help="a part of ordinal.json (some photos, some rounds) for `ampi eval depth --ordinal`")
+    sub.add_parser('merge', help='labels/*.tsv -> ordinal.json.gz')
+    s = sub.add_parser('subset', help="a part of ordinal.json.gz (some photos, some rounds) for `ampi eval depth --ordinal`")
     s.add_argument('out')
     s.add_argument('--prefix', action='append', default=[],
                    help='keep the photos whose name starts with this (repeatable; default all)')
