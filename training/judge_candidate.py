@@ -76,7 +76,7 @@ def verdicts(candidate, against, holdout_better, test_worse, synthetic_lower):
 
 
 def report(candidate_name, against_name, candidate, against, bars):
-    lines = [f'| weights | `holdout` WHDR | `test` WHDR | `val` WHDR (no bar) | synthetic delta < 1.25 |',
+    lines = ['| weights | `holdout` WHDR | `test` WHDR | `val` WHDR (no bar) | synthetic delta < 1.25 |',
              '|---|---:|---:|---:|---:|']
     for name, scores in ((against_name, against), (candidate_name, candidate)):
         lines.append(f'| {name} | ' + ' | '.join(f'{scores[k]:.4f}' for k in (*SPLITS, 'synthetic')) + ' |')
