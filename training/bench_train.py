@@ -2,7 +2,9 @@
 backward, optimiser and data included), for the old ways (one thread, scenes made in the
 loop; glibc's malloc thresholds left as they are) and the current one (every core,
 batches made ahead by a worker, freed blocks kept by training/malloc_reuse.py), written
-to training/BENCH_TRAIN.md.
+to training/BENCH_TRAIN.md; then the long runs' batch (4 scenes + 8 real photos) in fp32
+and, where the processor has bfloat16 instructions, under train_depth.py --bf16, for each
+network.
 
     /usr/bin/python3 training/bench_train.py [--steps 20] [--model lite]
 
@@ -46,6 +48,25 @@ def configurations(cores: int):
     return rows
 
 
+def precisions():
+    """(name, train_depth arguments) of fp32 and, where the processor runs bfloat16 dot
+    products in hardware, bf16 autocast: elsewhere it is emulated and only slower."""
+    rows = [("fp32", [])]
+    if cpu_flags() & {"avx512_bf16", "amx_bf16"}:
+        rows.append(("bf16 autocast (`--bf16`)", ["--bf16"]))
+    return rows
+
+
+def cpu_flags() -> set:
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith(("flags", "Features")):
+                return set(line.split(":", 1)[1].split())
+    except OSError:
+        pass
+    return set()
+
+
 def processor_name() -> str:
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
@@ -70,6 +91,13 @@ def measure(model: str, size: str, steps: int, extra):
     return seconds_per_step, 3600 * result["samples_per_step"] / seconds_per_step
 
 
+def timed_row(name: str, model: str, args, extra) -> str:
+    seconds, rate = measure(model, args.size, args.steps, extra)
+    row = f"| {name} | {seconds:.2f} | {rate:,.0f} |"
+    print(row, flush=True)
+    return row
+
+
 def main():
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--model", default="lite")
@@ -78,11 +106,11 @@ def main():
     p.add_argument("--output", default=str(TABLE))
     args = p.parse_args()
     cores = os.cpu_count() or 1
-    rows = []
-    for name, extra in configurations(cores):
-        seconds, rate = measure(args.model, args.size, args.steps, extra)
-        rows.append(f"| {name} | {seconds:.2f} | {rate:,.0f} |")
-        print(rows[-1], flush=True)
+    rows = [timed_row(name, args.model, args, extra) for name, extra in configurations(cores)]
+    long_runs = ["--threads", str(cores), "--workers", "1", "--batch", "4", "--ordinal", str(ORDINAL),
+                 "--ordinal-batch", "8"]
+    precision_rows = [timed_row(f"{model}, {name}", model, args, long_runs + extra)
+                      for model in ("lite", "heavy") for name, extra in precisions()] if ORDINAL.exists() else []
     load = " / ".join(f"{v:.1f}" for v in os.getloadavg())
     text = "\n".join([
         "# Depth training throughput",
@@ -96,6 +124,12 @@ def main():
         "| setup | s/step | samples/hour |",
         "|---|---:|---:|",
         *rows,
+        "",
+        f"The long runs' batch at {args.size}: {cores} threads, 1 worker, 4 scenes + 8 real photos (ranking loss).",
+        "",
+        "| network, precision | s/step | samples/hour |",
+        "|---|---:|---:|",
+        *precision_rows,
         "",
     ])
     Path(args.output).write_text(text)

@@ -245,8 +245,16 @@ class DepthNet(nn.Module):
         for i in reversed(range(len(self.dec))):
             y = self.dec[i](torch.cat([haar_idwt(y), skips[i]], dim=1))
             if i < NUM_OUTPUTS:
-                outputs.append(haar_idwt(self.heads[i](y)))
+                outputs.append(haar_idwt(self.head(i, y)))
         return outputs
+
+    def head(self, i: int, y: torch.Tensor) -> torch.Tensor:
+        """Head i, in fp32 even under bf16 autocast (train_depth.py --bf16), so the
+        disparity and every loss on it are fp32: bf16 keeps 8 significant bits (a
+        disparity of 5 would move in steps of 1/32), and grid_sample, which reads it at
+        the ranking loss's points, has no bf16 kernel on the CPU."""
+        with torch.autocast(y.device.type, enabled=False):
+            return self.heads[i](y.float())
 
     @torch.no_grad()
     def predict(self, rgb: torch.Tensor) -> torch.Tensor:
