@@ -212,7 +212,7 @@ def depth_command(args, model: str, workers: int) -> str:
             f"--ema {args.ema}{lr}{decay} "
             f"--minutes $minutes --val-every {args.val_every} --val-count {args.val_count} "
             f"--checkpoint-every {args.val_every} --ordinal {c}/ordinal.json --ordinal-batch {args.ordinal_batch} "
-            f"--rank-weight {args.rank_weight:g} --loss {args.loss}"
+            f"--rank-weight {args.rank_weight:g} --loss {args.loss}{' --bf16' if args.bf16 else ''}"
             + (f" --teacher-labels {c}/{TEACHER_LABELS} --teacher-weight {args.teacher_weight:g}" if args.teacher else ""))
 
 
@@ -413,6 +413,8 @@ def main(argv=None):
                        help="with --lr-decay cosine: the step (from the run's start) where lr reaches its floor")
     depth.add_argument("--val-count", type=int, default=32)
     depth.add_argument("--loss", choices=("paper", "invariant"), default="paper", help="train_depth.py --loss")
+    depth.add_argument("--bf16", action="store_true",
+                       help="train_depth.py --bf16: bfloat16 autocast (measured on this CPU, not yet on a GPU)")
     depth.add_argument("--size", default="256x192")
     depth.add_argument("--batch", type=int, default=48)
     depth.add_argument("--ordinal-batch", type=int, default=16)

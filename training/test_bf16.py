@@ -18,8 +18,9 @@ import train_depth  # noqa: E402
 
 
 def smooth_scene(seed: int, n: int = 2, side: int = 64):
-    """Photos and disparities with structure at the network's scales: a random field of
-    8x8 cells enlarged, so the loss on the disparity's gradients has edges to match."""
+    """Photos and disparities with structure at the network's scales: random values on a
+    grid of 8-pixel cells, enlarged bilinearly, so the loss on the disparity's gradients
+    has slopes to match."""
     g = torch.Generator().manual_seed(seed)
     cells = torch.rand(n, 4, side // 8, side // 8, generator=g)
     field = torch.nn.functional.interpolate(cells, size=(side, side), mode="bilinear", align_corners=False)

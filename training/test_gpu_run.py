@@ -81,7 +81,7 @@ class RoundTrip(unittest.TestCase):
                                         str(tmp / "ordinal.json"), "--device", "cpu", "--python", PYTHON, "--size", "64x64",
                                         "--batch", "2", "--ordinal-batch", "2", "--minutes", "0.05",
                                         "--threads", "1", "--workers", "2", "--scene-reuse", "2", "--val-count", "2",
-                                        "--lr-decay", "cosine", "--decay-steps", "1000", "--loss", "invariant",
+                                        "--lr-decay", "cosine", "--decay-steps", "1000", "--loss", "invariant", "--bf16",
                                         "--disparity-dir", str(tmp / "disparity"),
                                         "--teacher", "weights/depth_lite.ampw", "--teacher-weight", "0.5",
                                         "--teacher-resolutions", "64,96",
@@ -122,6 +122,7 @@ class RoundTrip(unittest.TestCase):
             self.assertIn("weights averaged (decay 0.999)", log)
             self.assertIn("rank weight 8, teacher", log)
             self.assertEqual(log.count("scale- and shift-invariant loss"), 2)
+            self.assertEqual(log.count("bf16 autocast"), 2)
             self.assertIn("cosine decay from 1.00e-03 to 1.00e-05 at step 1000", log)
             self.assertEqual(log.count("stopped after 0.05 minutes"), 2)
             self.assertIn("ordinal_whdr", log)
