@@ -58,23 +58,22 @@ def precisions():
 
 
 def cpu_flags() -> set:
-    try:
-        for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith(("flags", "Features")):
-                return set(line.split(":", 1)[1].split())
-    except OSError:
-        pass
-    return set()
+    return set(cpuinfo("flags", "Features").split())   # x86's name, then Arm's
 
 
 def processor_name() -> str:
+    return cpuinfo("model name") or platform.machine()
+
+
+def cpuinfo(*keys: str) -> str:
+    """The value of the first /proc/cpuinfo line starting with one of keys ('' if none)."""
     try:
         for line in Path("/proc/cpuinfo").read_text().splitlines():
-            if line.startswith("model name"):
+            if line.startswith(keys):
                 return line.split(":", 1)[1].strip()
     except OSError:
         pass
-    return platform.machine()
+    return ""
 
 
 def measure(model: str, size: str, steps: int, extra):
