@@ -141,7 +141,7 @@ def ordinal_table(ampi, threads):
         '`vertical-gradient` (lower = nearer) and `constant` are the guesses a network must beat.',
         'The validation photos (every fifth of each folder) are never trained on: their pairs of',
         'rounds 1, 2, 4, 7 and 9 (`val`) pick the best of a training run, those of rounds 3, 5, 6,',
-        "8 and 10-19 (`test`) never pick anything; but the same photos picked round after round, so",
+        "8 and 10-23 (`test`) never pick anything; but the same photos picked round after round, so",
         '`holdout` (every second archive photo of each of the two groups of packages added after',
         'every bundled file was made, `training/photo_folder.py`) is the one part no choice has',
         "seen: never trained on, never picked on, scored only to judge a pick. The training",
