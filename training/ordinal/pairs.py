@@ -61,7 +61,7 @@ ROUNDS = 23
 # joined `val`. Rounds 10-13 joined `test` before the long heavy run had a candidate: on
 # 1,005 ordered pairs, its bar "no worse on `test`" (training/DEPTH.md) was nearly a coin toss.
 # Rounds 14-19 joined it too before they were labelled, the long run still without one, and
-# rounds 20-23 when they were drawn (for more training pairs; no validation photo's labelled yet).
+# rounds 20-23 when they were drawn, before any of them was labelled.
 TEST_ROUNDS = (3, 5, 6, 8, *range(10, ROUNDS + 1))
 PAIRS_PER_ROUND = RANDOM_PAIRS + EDGE_PAIRS
 LABELS = ('A', 'B', '=')   # A nearer, B nearer, too close to call
