@@ -36,8 +36,7 @@ def step_gradient(model, batch, args, bf16: bool):
         def step(self):
             pass
 
-    args.bf16 = bf16
-    loss, *_ = train_depth.training_step(model, NoStep(), batch, args)
+    loss, *_ = train_depth.training_step(model, NoStep(), batch, argparse.Namespace(**{**vars(args), "bf16": bf16}))
     return float(loss), torch.cat([p.grad.flatten() for p in model.parameters()])
 
 
